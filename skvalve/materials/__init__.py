@@ -1,0 +1,19 @@
+"""Constitutive laws: one law per module, each a strain energy with stress and tangent derived.
+
+Continuum laws share the interface of :class:`~skvalve.materials.base.Hyperelastic`:
+``psi(F)``, ``pk1(F)``, ``cauchy(F)``, ``tangent(F)`` with ``F`` of shape (3, 3, *batch).
+"""
+
+from .base import Hyperelastic, VolumetricEnergy
+from .incompressible_neo_hookean import IncompressibleNeoHookean
+from .neo_hookean import NeoHookean
+
+__all__ = ["Hyperelastic", "VolumetricEnergy", "NeoHookean", "IncompressibleNeoHookean"]
+
+# Laws written by parallel work streams are exported when present.
+try:  # noqa: SIM105
+    from .exponential_fiber import ExponentialFiber  # noqa: F401
+
+    __all__.append("ExponentialFiber")
+except ImportError:  # pragma: no cover
+    pass

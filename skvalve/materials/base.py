@@ -1,0 +1,167 @@
+r"""Hyperelastic material interface: a strain energy of :math:`C`, stress and tangent derived.
+
+A law supplies the strain energy :math:`\psi(C)`, the second Piola–Kirchhoff stress
+:math:`S = 2\,\partial\psi/\partial C` and the material elasticity tensor
+:math:`\mathbb{C} = 2\,\partial S/\partial C = 4\,\partial^2\psi/\partial C\,\partial C`.
+Everything a solver needs in terms of :math:`F` follows here once for all laws:
+
+.. math::
+
+    P = F S, \qquad \sigma = J^{-1} P F^T, \qquad
+    \mathbb{A}_{iJkL} = \frac{\partial P_{iJ}}{\partial F_{kL}}
+                      = \delta_{ik} S_{JL} + F_{iI} F_{kK} \mathbb{C}_{IJKL}.
+
+Arrays keep tensor indices first and batch axes last (see :mod:`skvalve.kinematics`).
+
+Incompressible laws (``incompressible = True``) return only the part of the stress that
+the deformation determines; the hydrostatic pressure is a Lagrange multiplier supplied
+by the formulation (an analytic solution or a mixed u/p element). Their total stress is
+:math:`P = P_\text{law}(F) - p\,J F^{-T}`, :math:`\sigma = \sigma_\text{law} - p I`.
+
+Laws with a volumetric–rest split :math:`\psi(F) = \hat\psi(F) + U(J)` expose it via
+:meth:`Hyperelastic.split` so that a mixed u/p element can treat :math:`U` separately.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, fields
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..kinematics import Array, as_tensor_field, determinant, right_cauchy_green
+
+__all__ = ["Hyperelastic", "VolumetricEnergy", "check_positive", "check_nonnegative"]
+
+
+def check_positive(name: str, value: float) -> float:
+    """Return ``float(value)`` or raise ``ValueError`` naming the parameter."""
+    value = float(value)
+    if not np.isfinite(value) or value <= 0.0:
+        raise ValueError(f"parameter {name} must be positive and finite; got {value!r}")
+    return value
+
+
+def check_nonnegative(name: str, value: float) -> float:
+    """Return ``float(value)`` or raise ``ValueError`` naming the parameter."""
+    value = float(value)
+    if not np.isfinite(value) or value < 0.0:
+        raise ValueError(f"parameter {name} must be non-negative and finite; got {value!r}")
+    return value
+
+
+@dataclass(frozen=True)
+class VolumetricEnergy:
+    r"""A volumetric energy :math:`U(J)` with its first two derivatives.
+
+    ``kind`` selects the form: ``"quadratic"`` :math:`U = \tfrac{k}{2}(J-1)^2`
+    or ``"log"`` :math:`U = \tfrac{k}{2}(\ln J)^2`; ``modulus`` is :math:`k = U''(1)`.
+    (For a split law the small-strain bulk modulus also has a share from the rest.)
+    """
+
+    modulus: float
+    kind: str = "quadratic"
+
+    def __post_init__(self) -> None:
+        check_positive("modulus", self.modulus)
+        if self.kind not in ("quadratic", "log"):
+            raise ValueError(f"VolumetricEnergy kind must be 'quadratic' or 'log'; got {self.kind!r}")
+
+    def energy(self, J: ArrayLike) -> Array:
+        J = np.asarray(J, dtype=float)
+        if self.kind == "quadratic":
+            return 0.5 * self.modulus * (J - 1.0) ** 2
+        return 0.5 * self.modulus * np.log(J) ** 2
+
+    def first_derivative(self, J: ArrayLike) -> Array:
+        """:math:`U'(J)`, the hydrostatic pressure magnitude (tension positive)."""
+        J = np.asarray(J, dtype=float)
+        if self.kind == "quadratic":
+            return self.modulus * (J - 1.0)
+        return self.modulus * np.log(J) / J
+
+    def second_derivative(self, J: ArrayLike) -> Array:
+        J = np.asarray(J, dtype=float)
+        if self.kind == "quadratic":
+            return np.full_like(J, self.modulus)
+        return self.modulus * (1.0 - np.log(J)) / J**2
+
+
+class Hyperelastic(ABC):
+    """Base class of every continuum law: implement ``energy_C``, ``stress_C``, ``elasticity_C``."""
+
+    #: True when the law's stress is determined only up to a hydrostatic pressure.
+    incompressible: bool = False
+
+    # ----------------------------------------------------------------- the law
+    @abstractmethod
+    def energy_C(self, C: Array) -> Array:
+        r"""Strain energy per unit reference volume :math:`\psi(C)`, shape ``batch``."""
+
+    @abstractmethod
+    def stress_C(self, C: Array) -> Array:
+        r"""Second Piola–Kirchhoff stress :math:`S = 2\partial\psi/\partial C`."""
+
+    @abstractmethod
+    def elasticity_C(self, C: Array) -> Array:
+        r"""Material elasticity :math:`\mathbb{C} = 2\partial S/\partial C`, shape (3,3,3,3,*batch)."""
+
+    def response_C(self, C: Array) -> tuple[Array, Array]:
+        """``(S, elasticity)`` together; laws override this to share intermediate work."""
+        return self.stress_C(C), self.elasticity_C(C)
+
+    def split(self) -> tuple[Hyperelastic, VolumetricEnergy | None]:
+        r"""Return ``(rest, U)`` with :math:`\psi = \hat\psi + U(J)`; ``(self, None)`` if no split."""
+        return self, None
+
+    # --------------------------------------------------- derived, in terms of F
+    def psi(self, F: ArrayLike) -> Array:
+        """Strain energy per unit reference volume at deformation gradients ``F``."""
+        return self.energy_C(self._C(F))
+
+    def pk2(self, F: ArrayLike) -> Array:
+        """Second Piola–Kirchhoff stress, shape (3, 3, *batch)."""
+        return self.stress_C(self._C(F))
+
+    def pk1(self, F: ArrayLike) -> Array:
+        """First Piola–Kirchhoff stress :math:`P = F S`, shape (3, 3, *batch)."""
+        F = as_tensor_field(F)
+        return np.einsum("iI...,IJ...->iJ...", F, self.stress_C(self._C(F)))
+
+    def cauchy(self, F: ArrayLike) -> Array:
+        r"""Cauchy stress :math:`\sigma = J^{-1} F S F^T`, shape (3, 3, *batch)."""
+        F = as_tensor_field(F)
+        S = self.stress_C(self._C(F))
+        return np.einsum("iI...,IJ...,jJ...->ij...", F, S, F) / determinant(F)
+
+    def tangent(self, F: ArrayLike) -> Array:
+        r"""First elasticity tensor :math:`\partial P_{iJ}/\partial F_{kL}`, shape (3,3,3,3,*batch)."""
+        return self.pk1_and_tangent(F)[1]
+
+    def pk1_and_tangent(self, F: ArrayLike) -> tuple[Array, Array]:
+        """``(P, dP/dF)`` sharing the work of one constitutive evaluation."""
+        F = as_tensor_field(F)
+        S, CC = self.response_C(self._C(F))
+        P = np.einsum("iI...,IJ...->iJ...", F, S)
+        FCC = np.einsum("iI...,IJKL...->iJKL...", F, CC)
+        A = np.einsum("kK...,iJKL...->iJkL...", F, FCC)
+        for i in range(3):
+            A[i, :, i, :] += S
+        return P, A
+
+    # ----------------------------------------------------------------- helpers
+    def _C(self, F: ArrayLike) -> Array:
+        F = as_tensor_field(F)
+        J = determinant(F)
+        if np.any(~(J > 0.0)):
+            idx = np.argwhere(np.atleast_1d(~(J > 0.0)))[0]
+            raise ValueError(
+                f"{type(self).__name__}: det F must be positive; got {np.atleast_1d(J)[tuple(idx)]!r} "
+                f"at batch index {tuple(int(i) for i in idx)}"
+            )
+        return right_cauchy_green(F)
+
+    def parameters(self) -> dict[str, object]:
+        """The law's parameters by name (dataclass fields)."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}  # type: ignore[arg-type]

@@ -1,0 +1,98 @@
+r"""Isotropic laws written as :math:`\psi(\bar I_1, J)`: stress and tangent by the chain rule.
+
+With :math:`\bar I_1 = J^{-2/3} I_1` and :math:`J = \sqrt{\det C}` the derivatives with
+respect to :math:`C` are (:math:`C^{-1}` written :math:`G`)
+
+.. math::
+
+    \frac{\partial J}{\partial C} = \frac J2 G, \qquad
+    \frac{\partial \bar I_1}{\partial C} = J^{-2/3}\Big(I - \frac{I_1}{3} G\Big),
+
+    \frac{\partial^2 J}{\partial C^2} = \frac J4 G\otimes G - \frac J2 \mathbb{G}, \qquad
+    \frac{\partial^2 \bar I_1}{\partial C^2} = -\frac{J^{-2/3}}{3}(I\otimes G + G\otimes I)
+        + \frac{\bar I_1}{9} G\otimes G + \frac{\bar I_1}{3}\mathbb{G},
+
+with :math:`\mathbb{G}_{IJKL} = \tfrac12 (G_{IK}G_{JL} + G_{IL}G_{JK}) = -\partial G_{IJ}/\partial C_{KL}`.
+Then :math:`S = 2(\psi_{,\bar I}\,\partial\bar I_1/\partial C + \psi_{,J}\,\partial J/\partial C)`
+and :math:`\mathbb{C} = 4\,\partial^2\psi/\partial C^2` collects the products of the
+second partials :math:`\psi_{,\bar I\bar I}, \psi_{,\bar I J}, \psi_{,JJ}` with the first
+derivatives plus :math:`\psi_{,\bar I}` and :math:`\psi_{,J}` times the second derivatives.
+A law only states :math:`\psi` and its five partials (:meth:`IsotropicInvariantLaw.partials`).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from ..kinematics import Array, determinant, identity_like, inverse
+from .base import Hyperelastic
+
+__all__ = ["IsotropicInvariantLaw", "Partials"]
+
+
+class Partials(NamedTuple):
+    """ψ and its partial derivatives in :math:`(\\bar I_1, J)`."""
+
+    psi: Array
+    d_I: Array
+    d_J: Array
+    d_II: Array
+    d_IJ: Array
+    d_JJ: Array
+
+
+def _outer(A: Array, B: Array) -> Array:
+    return np.einsum("IJ...,KL...->IJKL...", A, B)
+
+
+class IsotropicInvariantLaw(Hyperelastic):
+    r"""Base for laws :math:`\psi(\bar I_1, J)`; ``C`` is passed too for direction-dependent laws."""
+
+    def partials(self, I1bar: Array, J: Array, C: Array) -> Partials:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _kinematic_terms(self, C: Array):
+        J = np.sqrt(determinant(C))
+        G = inverse(C)
+        I1 = np.trace(C)
+        Jm23 = J ** (-2.0 / 3.0)
+        I1bar = Jm23 * I1
+        eye = identity_like(C)
+        dI = Jm23 * (eye - I1 / 3.0 * G)
+        dJ = 0.5 * J * G
+        return J, G, I1bar, Jm23, eye, dI, dJ
+
+    def energy_C(self, C: Array) -> Array:
+        J, _, I1bar, *_ = self._kinematic_terms(C)
+        return self.partials(I1bar, J, C).psi
+
+    def stress_C(self, C: Array) -> Array:
+        J, _, I1bar, _, _, dI, dJ = self._kinematic_terms(C)
+        p = self.partials(I1bar, J, C)
+        return 2.0 * (p.d_I * dI + p.d_J * dJ)
+
+    def elasticity_C(self, C: Array) -> Array:
+        return self.response_C(C)[1]
+
+    def response_C(self, C: Array) -> tuple[Array, Array]:
+        J, G, I1bar, Jm23, eye, dI, dJ = self._kinematic_terms(C)
+        p = self.partials(I1bar, J, C)
+        S = 2.0 * (p.d_I * dI + p.d_J * dJ)
+        GG = _outer(G, G)
+        Gsym = 0.5 * (np.einsum("IK...,JL...->IJKL...", G, G) + np.einsum("IL...,JK...->IJKL...", G, G))
+        d2J = 0.25 * J * GG - 0.5 * J * Gsym
+        d2I = (
+            -Jm23 / 3.0 * (_outer(eye, G) + _outer(G, eye))
+            + I1bar / 9.0 * GG
+            + I1bar / 3.0 * Gsym
+        )
+        CC = 4.0 * (
+            p.d_II * _outer(dI, dI)
+            + p.d_IJ * (_outer(dI, dJ) + _outer(dJ, dI))
+            + p.d_JJ * _outer(dJ, dJ)
+            + p.d_I * d2I
+            + p.d_J * d2J
+        )
+        return S, CC
