@@ -1,1 +1,5 @@
-"""skvalve.analytic"""
+"""Closed-form and 1-D root-solved reference solutions."""
+
+from .homogeneous import HomogeneousResponse, biaxial, equibiaxial, uniaxial
+
+__all__ = ["HomogeneousResponse", "uniaxial", "equibiaxial", "biaxial"]

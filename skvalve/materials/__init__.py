@@ -5,10 +5,21 @@ Continuum laws share the interface of :class:`~skvalve.materials.base.Hyperelast
 """
 
 from .base import Hyperelastic, VolumetricEnergy
+from .bimodular_neo_hookean import BimodularNeoHookean
 from .incompressible_neo_hookean import IncompressibleNeoHookean
+from .lee_sacks import LeeSacks
 from .neo_hookean import NeoHookean
+from .ogden import Ogden
 
-__all__ = ["Hyperelastic", "VolumetricEnergy", "NeoHookean", "IncompressibleNeoHookean"]
+__all__ = [
+    "Hyperelastic",
+    "VolumetricEnergy",
+    "NeoHookean",
+    "IncompressibleNeoHookean",
+    "Ogden",
+    "LeeSacks",
+    "BimodularNeoHookean",
+]
 
 # Laws written by parallel work streams are exported when present.
 try:  # noqa: SIM105
