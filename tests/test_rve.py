@@ -1,0 +1,198 @@
+"""RVE force balance, Eq. 8 stress and the consistent tangent (Thomas 2019 section 2.4)."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from skvalve.materials.exponential_fiber import ExponentialFiber
+from skvalve.networks.generate import generate
+from skvalve.networks.network import Network
+from skvalve.networks.rve import RVEState, boundary_stress, solve_rve, solve_rve_batch
+
+E_F, BETA, LAMBDA_C, DIAMETER, PSI = 10.5e3, 50.5, 1.12, 450e-9, 0.43
+AREA = math.pi * DIAMETER**2 / 4
+
+
+def eq9(lam):
+    """Eq. 9 written out independently of ExponentialFiber (scalar)."""
+    if lam < LAMBDA_C:
+        return E_F * AREA / BETA * (math.exp(BETA * 0.5 * (lam**2 - 1)) - 1)
+    ec = 0.5 * (LAMBDA_C**2 - 1)
+    return E_F * AREA / BETA * (math.exp(BETA * ec) - 1) + E_F * AREA * LAMBDA_C * math.exp(BETA * ec) * (
+        lam - LAMBDA_C
+    )
+
+
+@pytest.fixture(scope="module")
+def fiber():
+    return ExponentialFiber.from_diameter(E_F, DIAMETER, BETA, LAMBDA_C)
+
+
+@pytest.fixture(scope="module")
+def network():
+    return generate(35.0, 20.0, n_fibers=200, seed=4)
+
+
+F_BIAXIAL = np.array([[1.12, 0.03, 0.0], [0.01, 1.08, 0.02], [0.0, 0.0, 0.80]])
+
+
+def test_affine_network_matches_eq8_by_hand(fiber):
+    # every node on a face: no unknowns, the network deforms affinely
+    nodes = np.array(
+        [[-0.5, -0.2, 0.1], [0.5, 0.3, -0.1], [0.2, -0.5, 0.0], [-0.1, 0.5, 0.4], [0.3, 0.1, -0.5], [0.0, 0.2, 0.5]]
+    )
+    face = np.array([0, 1, 2, 3, 4, 5])
+    net = Network(nodes, [[0, 1], [2, 3], [4, 5], [0, 3]], np.ones(6, bool), face)
+    result = solve_rve(net, F_BIAXIAL, fiber)
+    J = np.linalg.det(F_BIAXIAL)
+    total = sum(np.linalg.norm(nodes[b] - nodes[a]) for a, b in net.fibers)
+    expected = np.zeros((3, 3))
+    for a, b in net.fibers:
+        d = F_BIAXIAL @ (nodes[b] - nodes[a])
+        ell = np.linalg.norm(d)
+        lam = ell / np.linalg.norm(nodes[b] - nodes[a])
+        expected += eq9(lam) * np.outer(d, d) / ell
+    expected *= PSI / (total * AREA * J)
+    np.testing.assert_allclose(result.cauchy, expected, rtol=1e-12, atol=1e-12 * abs(expected).max())
+
+
+def test_single_fiber_uniaxial_exact_force(fiber):
+    net = Network([[-0.5, 0, 0], [0.5, 0, 0]], [[0, 1]], [True, True], [0, 1])
+    for lam in (0.9, 1.05, 1.2):
+        result = solve_rve(net, np.diag([lam, 1.0, 1.0]), fiber)
+        assert result.fiber_stretch[0] == pytest.approx(lam, rel=1e-15)
+        # σ_xx = ψ/(L A_f V) · x·f with L = 1, V = λ, x·f = λ f
+        assert result.cauchy[0, 0] == pytest.approx(PSI / AREA * eq9(lam), rel=1e-12)
+        assert np.count_nonzero(result.cauchy) == 1
+
+
+def test_interior_node_of_a_chain_finds_equal_stretch(fiber):
+    # −½ → 0.2 → ½ along x; equal forces need equal stretches: node at 0.2 λ
+    net = Network([[-0.5, 0, 0], [0.2, 0, 0], [0.5, 0, 0]], [[0, 1], [1, 2]], [True, False, True], [0, -1, 1])
+    F = np.diag([1.1, 1.0, 1.0])
+    start = np.array([[-0.55, 0, 0], [0.05, 0.02, -0.01], [0.55, 0, 0]])  # off equilibrium
+    result = solve_rve(net, F, fiber, state=RVEState(start, F, np.zeros((3, 9))), tol=1e-13)
+    np.testing.assert_allclose(result.deformed_nodes[1], [0.22, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(result.fiber_stretch, 1.1, rtol=1e-12)
+    assert result.iterations > 1
+
+
+def test_force_balance_residual(network, fiber):
+    result = solve_rve(network, F_BIAXIAL, fiber)
+    x = result.deformed_nodes
+    d = network.fiber_vectors(x)
+    ell = np.linalg.norm(d, axis=1)
+    f = fiber.force(ell / network.fiber_lengths())
+    net_force = np.zeros_like(x)
+    np.add.at(net_force, network.fibers[:, 0], f[:, None] * d / ell[:, None])
+    np.add.at(net_force, network.fibers[:, 1], -f[:, None] * d / ell[:, None])
+    interior = ~network.boundary
+    relative = np.linalg.norm(net_force[interior]) / np.linalg.norm(f)
+    assert relative < 1e-10
+    # the motion is genuinely non-affine
+    assert np.abs(x[interior] - network.nodes[interior] @ F_BIAXIAL.T).max() > 1e-3
+    # Eq. 8 summed over boundary cross-links equals the fiber virial
+    np.testing.assert_allclose(
+        boundary_stress(network, result, fiber), result.cauchy, rtol=1e-8, atol=1e-8 * abs(result.cauchy).max()
+    )
+
+
+def test_objectivity(network, fiber):
+    result = solve_rve(network, F_BIAXIAL, fiber)
+    R = Rotation.from_rotvec([0.3, -1.1, 0.7]).as_matrix()
+    rotated = solve_rve(network, R @ F_BIAXIAL, fiber)
+    np.testing.assert_allclose(rotated.fiber_stretch, result.fiber_stretch, rtol=1e-10)
+    np.testing.assert_allclose(rotated.cauchy, R @ result.cauchy @ R.T, rtol=1e-8, atol=1e-9 * abs(result.cauchy).max())
+    # pure rotation: no stretch, no stress
+    spin = solve_rve(network, R, fiber)
+    np.testing.assert_allclose(spin.fiber_stretch, 1.0, atol=1e-12)
+    assert abs(spin.cauchy).max() < 1e-9 * abs(result.cauchy).max()
+
+
+def test_tangent_matches_finite_differences(network, fiber):
+    result = solve_rve(network, F_BIAXIAL, fiber)
+    h = 1e-6
+    fd = np.zeros((3, 3, 3, 3))
+    for p in range(3):
+        for q in range(3):
+            dF = np.zeros((3, 3))
+            dF[p, q] = h
+            plus = solve_rve(network, F_BIAXIAL + dF, fiber, state=result.state, tol=1e-12)
+            minus = solve_rve(network, F_BIAXIAL - dF, fiber, state=result.state, tol=1e-12)
+            fd[:, :, p, q] = (plus.cauchy - minus.cauchy) / (2 * h)
+    error = abs(result.tangent - fd).max() / abs(fd).max()
+    assert error < 1e-6
+    # the affine (no-relaxation) part alone would be far off: the implicit term matters
+    assert abs(result.tangent).max() > 0
+
+
+def test_warm_start_and_batch_agree(network, fiber):
+    cold = solve_rve(network, F_BIAXIAL, fiber)
+    F2 = F_BIAXIAL + 2e-3 * np.eye(3)
+    warm = solve_rve(network, F2, fiber, state=cold.state)
+    reference = solve_rve(network, F2, fiber)
+    assert warm.iterations < reference.iterations
+    np.testing.assert_allclose(warm.cauchy, reference.cauchy, rtol=1e-9)
+    other = generate(27.0, 90.0, n_fibers=150, seed=2)
+    batch = solve_rve_batch([network, other], np.stack([F2, F_BIAXIAL]), fiber, states=[cold.state, None])
+    np.testing.assert_allclose(batch[0].cauchy, warm.cauchy, rtol=1e-12)
+    np.testing.assert_allclose(batch[1].cauchy, solve_rve(other, F_BIAXIAL, fiber).cauchy, rtol=1e-12)
+
+
+def test_large_cold_step_converges_and_diameter_cancels(network):
+    F = np.diag([1.3, 1.3, 1 / 1.69])
+    thin = ExponentialFiber.from_diameter(E_F, 100e-9, BETA, LAMBDA_C)
+    thick = ExponentialFiber.from_diameter(E_F, 900e-9, BETA, LAMBDA_C)
+    a = solve_rve(network, F, thin, fiber_diameter=100e-9)
+    b = solve_rve(network, F, thick, fiber_diameter=900e-9)
+    assert a.status == 0 and a.residual < 1e-10
+    np.testing.assert_allclose(a.cauchy, b.cauchy, rtol=1e-9)
+    assert b.rve_edge_length == pytest.approx(9 * a.rve_edge_length, rel=1e-12)  # γ ∝ d
+
+
+def test_bad_input(network, fiber):
+    with pytest.raises(ValueError, match="det F"):
+        solve_rve(network, np.diag([1.0, 1.0, -1.0]), fiber)
+    with pytest.raises(ValueError, match="psi"):
+        solve_rve(network, np.eye(3), fiber, psi=1.5)
+    with pytest.raises(ValueError, match="shape"):
+        solve_rve(network, np.eye(2), fiber)
+    with pytest.raises(ValueError, match="state"):
+        solve_rve(network, np.eye(3), fiber, state=RVEState(np.zeros((2, 3)), np.eye(3), np.zeros((1, 9))))
+
+
+@pytest.mark.parametrize("compression", ["paper", "buckle"])
+def test_compressed_network_converges(network, compression):
+    # biaxial compression: most fibers shorten, K loses definiteness along the path
+    fiber = ExponentialFiber.from_diameter(E_F, DIAMETER, BETA, LAMBDA_C, compression=compression)
+    result = solve_rve(network, np.diag([0.9, 0.9, 1.0]), fiber, max_iter=100)
+    assert result.status == 0
+    x = result.deformed_nodes
+    d = network.fiber_vectors(x)
+    ell = np.linalg.norm(d, axis=1)
+    f = fiber.force(ell / network.fiber_lengths())
+    net_force = np.zeros_like(x)
+    np.add.at(net_force, network.fibers[:, 0], f[:, None] * d / ell[:, None])
+    np.add.at(net_force, network.fibers[:, 1], -f[:, None] * d / ell[:, None])
+    # balanced to 1e-8 of the (small, compressive) fiber forces
+    assert np.linalg.norm(net_force[~network.boundary]) < 1e-8 * np.linalg.norm(f)
+    assert result.cauchy[0, 0] < 0 and result.cauchy[1, 1] < 0
+
+
+def test_dense_cholesky_against_numpy():
+    from skvalve.networks.dense_cholesky import cholesky_in_place, cholesky_solve, factor_with_shift
+
+    rng = np.random.default_rng(1)
+    a = rng.normal(size=(40, 40))
+    spd = a @ a.T + 40 * np.eye(40)
+    rhs = rng.normal(size=(40, 9))
+    work = spd.copy()
+    assert cholesky_in_place(work, 40)
+    y = rhs.copy()
+    cholesky_solve(work, 40, y)
+    np.testing.assert_allclose(y, np.linalg.solve(spd, rhs), rtol=1e-10, atol=1e-12)
+    indefinite = spd - (np.linalg.eigvalsh(spd)[0] + 1.0) * np.eye(40)  # one negative eigenvalue
+    assert not cholesky_in_place(indefinite.copy(), 40)
+    assert not factor_with_shift(indefinite, np.empty((40, 40)), 40)  # shifted, flagged
