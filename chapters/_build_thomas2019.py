@@ -476,16 +476,18 @@ print("hand-worked values: 0.73383, 0.26617, 0.07500, 65.87 %, 8.89°")
 md(r"""
 ## Solution 4
 
-Within a bin of half-width $w/2$ in θ, $\cos 2\theta$ and $\sin 2\theta$ (the deviatoric part
-of $r\otimes r$) average to their value at the centre times $\frac{1}{w}\int_{-w/2}^{w/2}\cos\phi\,d\phi
-= \sin(w/2)/(w/2)$ with $w$ the bin width in $2\theta$ (60°), i.e. the factor
-$\sin 30°/(\pi/6) = 0.9549$.  The deviatoric radius becomes $0.9549 \times 0.24556 = 0.23449$,
-so $\alpha = 100(1 - 0.26551/0.73449) = 63.85\,\%$: binning at the centres over-estimates α by 2 %.
-The cell checks this with a fine quadrature of the piecewise-constant density.
+A bin of width 30° in θ spans $2w = 60°$ in $2\theta$.  Over it, $\cos 2\theta$ and $\sin 2\theta$ (the
+deviatoric part of $r\otimes r$) average to their value at the bin centre times
+$\frac{1}{2w}\int_{-w}^{w}\cos\phi\,d\phi = \sin w/w$, while the isotropic part ($\tfrac12 I$) is
+unchanged.  With $w = 30°$ the factor is $\sin 30°/(\pi/6) = 0.9549$, the same in every bin, so the
+eigenvectors (and μ) do not change.  The deviatoric radius becomes $0.9549 \times 0.24556 = 0.23449$,
+so $\alpha = 100(1 - 0.26551/0.73449) = 63.85\,\%$: binning at the centres over-estimates α by about
+2 percentage points.  The cell checks this with a midpoint quadrature of the piecewise-constant density.
 """)
 
 code(r"""
-theta = np.linspace(-np.pi / 2, np.pi / 2, 36000, endpoint=False)
+n_points = 36000  # midpoints: every 30° bin holds 6000 points placed symmetrically about its centre
+theta = -np.pi / 2 + (np.arange(n_points) + 0.5) * np.pi / n_points
 density = counts[np.minimum(((np.degrees(theta) + 90) // 30).astype(int), 5)]
 H_uniform = orientation_tensor(theta, weights=density)
 factor = np.sin(np.radians(30)) / np.radians(30)

@@ -100,13 +100,25 @@ def cofactor(A: ArrayLike) -> Array:
 
 
 def inverse(A: ArrayLike) -> Array:
-    """Inverse of 3x3 tensors via the cofactor; raises ``ValueError`` where singular."""
+    """Inverse of 3x3 tensors via the cofactor; raises ``ValueError`` where singular or not finite."""
     A = as_tensor_field(A, "A")
     det = determinant(A)
-    if np.any(det == 0.0):
-        bad = np.argwhere(np.atleast_1d(det == 0.0))
-        raise ValueError(f"singular tensor at batch index {tuple(bad[0])}")
+    bad = ~np.isfinite(det) | (det == 0.0)
+    if np.any(bad):
+        where = tuple(int(i) for i in np.argwhere(np.atleast_1d(bad))[0])
+        raise ValueError(
+            f"inverse: singular or non-finite tensor (det = {float(np.atleast_1d(det)[where])!r}) "
+            f"at batch index {where}"
+        )
     return np.swapaxes(cofactor(A), 0, 1) / det
+
+
+def _require_positive_det(F: Array, who: str) -> None:
+    """``ValueError`` unless F is finite with det F > 0 everywhere."""
+    if not np.all(np.isfinite(F)):
+        raise ValueError(f"{who} needs a finite F; got NaN or inf")
+    if np.any(determinant(F) <= 0.0):
+        raise ValueError(f"{who} needs det F > 0 everywhere")
 
 
 def invariants(F: ArrayLike) -> tuple[Array, Array, Array]:
@@ -146,8 +158,7 @@ def polar_decomposition(F: ArrayLike) -> tuple[Array, Array]:
     Requires :math:`\det F > 0`.
     """
     F = as_tensor_field(F)
-    if np.any(determinant(F) <= 0.0):
-        raise ValueError("polar_decomposition needs det F > 0 everywhere")
+    _require_positive_det(F, "polar_decomposition")
     U = _symmetric_function(right_cauchy_green(F), np.sqrt)
     R = np.einsum("iK...,KJ...->iJ...", F, inverse(U))
     return R, U
@@ -166,7 +177,6 @@ def log_strain(F: ArrayLike, spatial: bool = True) -> Array:
     :math:`\ln \lambda` in the 11 component.
     """
     F = as_tensor_field(F)
-    if np.any(determinant(F) <= 0.0):
-        raise ValueError("log_strain needs det F > 0 everywhere")
+    _require_positive_det(F, "log_strain")
     G = left_cauchy_green(F) if spatial else right_cauchy_green(F)
     return _symmetric_function(G, lambda w: 0.5 * np.log(w))

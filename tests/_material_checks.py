@@ -39,28 +39,29 @@ def random_rotations(n: int, seed: int) -> np.ndarray:
     return np.stack(out, axis=-1)
 
 
-def fd_pk1(law, F: np.ndarray, h: float = FD_STEP) -> np.ndarray:
-    """Central differences of psi with respect to every F_kL."""
-    P = np.zeros_like(F)
+def central_differences(fun, F: np.ndarray, h: float = FD_STEP) -> np.ndarray:
+    """d fun(F) / dF_kL by central differences: fun's tensor axes, then (k, L), then the batch axes."""
+    batch_ndim = F.ndim - 2
+    columns = []
     for k in range(3):
         for L in range(3):
             Fp, Fm = F.copy(), F.copy()
             Fp[k, L] += h
             Fm[k, L] -= h
-            P[k, L] = (law.psi(Fp) - law.psi(Fm)) / (2 * h)
-    return P
+            columns.append((fun(Fp) - fun(Fm)) / (2 * h))
+    value_ndim = columns[0].ndim - batch_ndim
+    stacked = np.stack(columns, axis=value_ndim)
+    return stacked.reshape(stacked.shape[:value_ndim] + (3, 3) + stacked.shape[value_ndim + 1 :])
+
+
+def fd_pk1(law, F: np.ndarray, h: float = FD_STEP) -> np.ndarray:
+    """Central differences of psi with respect to every F_kL, shape (3, 3, *batch)."""
+    return central_differences(law.psi, F, h)
 
 
 def fd_tangent(law, F: np.ndarray, h: float = FD_STEP) -> np.ndarray:
     """Central differences of pk1 with respect to every F_kL, shape (3, 3, 3, 3, *batch)."""
-    A = np.zeros((3, 3, 3, 3) + F.shape[2:])
-    for k in range(3):
-        for L in range(3):
-            Fp, Fm = F.copy(), F.copy()
-            Fp[k, L] += h
-            Fm[k, L] -= h
-            A[:, :, k, L] = (law.pk1(Fp) - law.pk1(Fm)) / (2 * h)
-    return A
+    return central_differences(law.pk1, F, h)
 
 
 def relative_error(a: np.ndarray, b: np.ndarray) -> float:

@@ -96,3 +96,12 @@ def test_energy_derivative_is_force(compression):
     fd = (fiber.energy(lam + h) - fiber.energy(lam - h)) / (2 * h)
     np.testing.assert_allclose(fd, fiber.force(lam), rtol=1e-7, atol=1e-9 * fiber.axial_rigidity)
     assert fiber.energy(1.0) == 0.0 and np.all(fiber.energy(lam) >= 0)
+
+
+def test_overflow_raises_naming_the_stretch():
+    """exp(β e_G) leaves float range for β = 1e4 at λ = 1.09 (β e_G ≈ 940 > 709): ValueError, not inf."""
+    steep = ExponentialFiber(1.0, 1.0, 1e4, 1.1)
+    for method in (steep.force, steep.stiffness, steep.energy):
+        with pytest.raises(ValueError, match="overflows at stretch 1.09"):
+            method([1.0, 1.09])
+        assert np.isfinite(method(1.0))

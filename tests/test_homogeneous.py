@@ -191,3 +191,30 @@ def test_scalar_and_array_shapes():
     assert np.shape(uniaxial(law, 1.2).J) == ()
     assert uniaxial(law, np.ones((2, 4))).cauchy.shape == (3, 2, 4)
     assert biaxial(law, np.ones(4), 1.1).stretches.shape == (3, 4)
+
+
+def test_empty_stretch_and_wrong_material():
+    law = IncompressibleNeoHookean(1.0)
+    empty = uniaxial(law, [])
+    assert empty.cauchy.shape == (3, 0) and empty.stretches.shape == (3, 0) and empty.nominal.shape == (3, 0)
+    assert biaxial(law, np.ones((0, 2)), 1.1).cauchy.shape == (3, 0, 2)
+    from skvalve.materials.exponential_fiber import ExponentialFiber
+
+    with pytest.raises(ValueError, match=r"stretch1 of shape \(2,\) and stretch2 of shape \(3,\)"):
+        biaxial(law, [1.1, 1.2], [1.0, 1.1, 1.2])
+    for not_a_law in ("neo-Hookean", ExponentialFiber(1.0, 1.0, 1.0, 1.1)):
+        with pytest.raises(TypeError, match="continuum law"):
+            uniaxial(not_a_law, 1.1)
+
+
+def test_compressible_neo_hookean_biaxial_against_independent_root():
+    """sigma33 = mu/J (l3^2 - 1) + lambda ln J / J = 0 (thomas2019 Eq. 13) solved here independently."""
+    law = NeoHookean.from_shear_poisson(2.1, 0.45)
+    mu, lm = law.mu, law.lmbda
+    out = biaxial(law, 1.2, STRETCHES, incompressible=False)
+    for i, lam2 in enumerate(STRETCHES):
+        l3 = brentq(lambda t, lam2=lam2: mu * (t**2 - 1) + lm * np.log(1.2 * lam2 * t), 0.05, 5.0, xtol=1e-15)
+        J = 1.2 * lam2 * l3
+        assert out.stretches[2, i] == pytest.approx(l3, rel=1e-12)
+        expected = np.array([mu / J * (1.2**2 - 1), mu / J * (lam2**2 - 1)]) + lm * np.log(J) / J
+        np.testing.assert_allclose(out.cauchy[:2, i], expected, rtol=1e-10, atol=1e-13)

@@ -81,3 +81,12 @@ def test_bad_input():
         kin.right_cauchy_green(np.zeros((2, 3)))
     with pytest.raises(ValueError, match="singular"):
         kin.inverse(np.zeros((3, 3, 1)))
+    nan_F = F.copy()
+    nan_F[1, 2, 3] = np.nan
+    with pytest.raises(ValueError, match=r"non-finite.*batch index \(3,\)"):
+        kin.inverse(nan_F)
+    for fun in (kin.polar_decomposition, kin.log_strain):
+        with pytest.raises(ValueError, match="finite F"):
+            fun(nan_F)
+        with pytest.raises(ValueError, match="det F > 0"):
+            fun(np.diag([1.0, -1.0, 1.0]))

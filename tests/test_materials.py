@@ -108,3 +108,52 @@ def test_bimodular_small_strain_tension_branch():
     eps = 1e-7 * np.diag([-0.5, -0.5, 1.0])
     sigma = law.cauchy((np.eye(3) + eps)[:, :, None])[..., 0]
     np.testing.assert_allclose(sigma, 2 * 9.0 * eps, rtol=1e-5)
+
+
+@pytest.mark.parametrize("name", sorted(LAWS))
+def test_shapes_lists_and_batches_agree_pointwise(name):
+    """F of shape (3, 3), a nested list and a (3, 3, 2, 5) batch give the per-point values."""
+    law = LAWS[name]
+    F = random_deformations(10, seed=6)
+    if isinstance(law, BimodularNeoHookean):
+        F = _away_from_switch(law, F)[..., :1].repeat(10, axis=-1)
+    single = F[..., 0]
+    for method, tensor_ndim in (("psi", 0), ("pk1", 2), ("cauchy", 2), ("tangent", 4)):
+        value = getattr(law, method)(single)
+        assert np.shape(value) == (3,) * tensor_ndim
+        np.testing.assert_array_equal(getattr(law, method)(single.tolist()), value)
+        batched = getattr(law, method)(F.reshape(3, 3, 2, 5))
+        assert batched.shape == (3,) * tensor_ndim + (2, 5)
+        expected = getattr(law, method)(F).reshape((3,) * tensor_ndim + (2, 5))
+        np.testing.assert_allclose(batched, expected, rtol=1e-14, atol=1e-14)
+        np.testing.assert_allclose(batched[..., 0, 0], value, rtol=1e-14, atol=1e-14)
+
+
+@pytest.mark.parametrize("name", sorted(LAWS))
+@pytest.mark.parametrize("method", ["psi", "pk1", "cauchy", "tangent"])
+def test_bad_deformations_raise_naming_the_point(name, method):
+    law = LAWS[name]
+    F = random_deformations(3, seed=7)
+    reflected = F.copy()
+    reflected[2, :, 1] *= -1.0  # det F < 0 at batch index 1
+    with pytest.raises(ValueError, match=r"det F must be positive.*batch index \(1,\)"):
+        getattr(law, method)(reflected)
+    with pytest.raises(ValueError, match="det F must be positive"):
+        getattr(law, method)(np.diag([1.0, 1.0, 0.0]))
+    for bad in (np.nan, np.inf):
+        broken = F.copy()
+        broken[0, 1, 2] = bad  # det F is not even defined: say so, not 'det F = nan'
+        with pytest.raises(ValueError, match=r"F must be finite.*batch index \(2,\)"):
+            getattr(law, method)(broken)
+    with pytest.raises(ValueError, match="shape"):
+        getattr(law, method)(np.eye(2))
+
+
+@pytest.mark.parametrize("method", ["psi", "pk1", "cauchy", "tangent"])
+def test_overflow_raises_instead_of_returning_inf_or_nan(method):
+    """exp(c2 (I1bar - 3)^2) overflows at stretch 3 for c2 = 1000: a ValueError, never inf/NaN."""
+    law = LeeSacks(1.0, 0.1, 1000.0, 0.5)
+    F = np.stack([np.eye(3), np.diag([3.0, 1.0, 1.0])], axis=-1)
+    with np.errstate(all="ignore"), pytest.raises(ValueError, match=r"overflows.*batch index \(1,\)"):
+        getattr(law, method)(F)
+    assert np.all(np.isfinite(getattr(law, method)(F[..., :1])))

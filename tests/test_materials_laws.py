@@ -95,6 +95,11 @@ def test_split_without_single_volumetric_term_returns_self(law):
     assert law.split() == (law, None)
 
 
+def test_ogden_D_none_means_incompressible_like_lee_sacks():
+    assert Ogden((1.0,), (3.0,), None) == Ogden((1.0,), (3.0,))
+    assert Ogden((1.0,), (3.0,), None).incompressible
+
+
 def test_incompressible_flags():
     assert Ogden((1.0,), (2.0,)).incompressible and not Ogden((1.0,), (2.0,), (1.0,)).incompressible
     assert LeeSacks(1.0, 0.1, 1.0).incompressible and not LeeSacks(1.0, 0.1, 1.0, 0.5).incompressible
@@ -123,12 +128,36 @@ def test_incompressible_flags():
         (lambda: LeeSacks(1.0, -0.1, 1.0), "parameter c1"),
         (lambda: LeeSacks(1.0, 0.1, -1.0), "parameter c2"),
         (lambda: LeeSacks(1.0, 0.1, 1.0, 0.0), "parameter D"),
+        (lambda: LeeSacks(1.0, 0.1, 1.0, 0.5, "yes"), "published_equation must be True or False"),
+        (lambda: Ogden((1.0,), (2.0,), (np.nan,)), "D must be finite"),
         (lambda: VolumetricEnergy(-1.0), "modulus"),
     ],
 )
 def test_parameter_validation_names_the_parameter(factory, match):
     with pytest.raises(ValueError, match=match):
         factory()
+
+
+@pytest.mark.parametrize("kind", ["quadratic", "log"])
+def test_volumetric_energy_derivatives_match_finite_differences(kind):
+    """U' and U'' (used by the mixed u/p element's K_pp) against central differences of U and U'."""
+    U = VolumetricEnergy(2.5, kind)
+    J, h = np.array([0.6, 0.95, 1.0, 1.3, 2.0]), 1e-6
+    fd_first = (U.energy(J + h) - U.energy(J - h)) / (2 * h)
+    fd_second = (U.first_derivative(J + h) - U.first_derivative(J - h)) / (2 * h)
+    np.testing.assert_allclose(U.first_derivative(J), fd_first, rtol=1e-8, atol=1e-9)
+    np.testing.assert_allclose(U.second_derivative(J), fd_second, rtol=1e-8)
+    assert U.energy(np.array([1.0]))[0] == 0.0 and U.first_derivative(np.array([1.0]))[0] == 0.0
+
+
+def test_log_volumetric_energy_rejects_non_positive_J():
+    U = VolumetricEnergy(3.0, "log")
+    for method in (U.energy, U.first_derivative, U.second_derivative):
+        with pytest.raises(ValueError, match="J must be positive"):
+            method(np.array([1.0, 0.0]))
+    # the quadratic form is defined for any J (a penalty); U''(1) = k for both kinds
+    assert VolumetricEnergy(3.0).second_derivative(np.array([-0.5]))[0] == 3.0
+    assert U.second_derivative(np.array([1.0]))[0] == pytest.approx(3.0, rel=1e-15)
 
 
 def test_non_positive_det_raises():

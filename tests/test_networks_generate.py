@@ -19,7 +19,7 @@ def test_targets_are_met(networks):
         a, m = network_alpha_mu(net)  # measured independently of the generator's meta
         assert abs(a - alpha) <= 3.0
         assert abs((m - mu + 90) % 180 - 90) <= 5.0
-        assert 350 <= net.n_fibers <= 560  # "~450 fibers"
+        assert 405 <= net.n_fibers <= 495  # "~450 fibers": the generator keeps the count within ±10 %
 
 
 def test_geometry_and_tags(networks):
@@ -54,6 +54,18 @@ def test_random_target_and_bad_input():
         generate(120.0, 0.0)
     with pytest.raises(ValueError, match="n_fibers"):
         generate(30.0, 0.0, n_fibers=5)
+    with pytest.raises(ValueError, match="n_fibers"):
+        generate(30.0, 0.0, n_fibers=200.5)
+    for seed in (None, -1, 1.5):
+        with pytest.raises(ValueError, match="seed"):
+            generate(30.0, 0.0, seed=seed)
+    # a negative tolerance used to run all 200 sub-seeds before a RuntimeError
+    with pytest.raises(ValueError, match="alpha_tol"):
+        generate(30.0, 0.0, alpha_tol=-1.0)
+    with pytest.raises(ValueError, match="mu_tol"):
+        generate(30.0, 0.0, mu_tol=0.0)
+    with pytest.raises(ValueError, match="mu"):
+        generate(30.0, np.nan)
 
 
 def test_clipping_by_hand():
@@ -111,3 +123,25 @@ def test_library_cache_roundtrip(tmp_path, monkeypatch):
     np.testing.assert_array_equal(net.nodes, original.nodes)
     np.testing.assert_array_equal(net.face, original.face)
     assert net.meta["alpha_target"] == 40.0
+
+
+def test_library_cache_does_not_confuse_targets_that_round_alike(tmp_path, monkeypatch):
+    """File names hold α, μ to 0.01: α = 25.001 and α = 25.0 share a name but are different networks."""
+    calls = []
+
+    def fake_generate(alpha, mu, n_fibers, seed):
+        calls.append(alpha)
+        net = Network([[-0.5, 0, 0], [0.5, 0, 0]], [[0, 1]], [True, True], [0, 1])
+        net.meta.update(alpha_target=float(alpha), mu_target=float(mu))
+        return net
+
+    monkeypatch.setattr(library, "generate", fake_generate)
+    library.cached_network(25.001, 0.0, 150, 3, directory=tmp_path)
+    assert library.cached_network(25.0, 0.0, 150, 3, directory=tmp_path).meta["alpha_target"] == 25.0
+    assert library.cached_network(25.0, 0.0, 150, 3, directory=tmp_path).meta["alpha_target"] == 25.0
+    assert calls == [25.001, 25.0]  # the second 25.0 is a cache hit
+
+
+def test_network_rejects_non_finite_nodes():
+    with pytest.raises(ValueError, match="finite"):
+        Network([[np.nan, 0, 0], [0.5, 0, 0]], [[0, 1]], [True, True], [0, 1])

@@ -66,6 +66,13 @@ def test_axial_symmetry_and_rotation():
     assert anisotropy_index(orientation_tensor(theta + shift, w)) == pytest.approx(anisotropy_index(H), abs=1e-9)
 
 
+def test_plain_lists_are_accepted():
+    H = orientation_tensor([0.0, np.pi / 2, 0.0])  # two fibers along x, one along y
+    np.testing.assert_allclose(H, np.diag([2 / 3, 1 / 3]), atol=1e-15)
+    assert anisotropy_index(H.tolist()) == pytest.approx(50.0, abs=1e-12)
+    assert mean_direction(H.tolist()) == pytest.approx(0.0, abs=1e-12)
+
+
 def test_projection_weights_by_projected_length():
     # two fibers along x (length 1 and 2 in plane) and one along z (projects to a point)
     nodes = np.array([[0, 0, 0], [1, 0, 0], [0, 0, 0.0], [0, 2, 0.5], [0, 0, 0], [0, 0, 1]], dtype=float)
@@ -82,6 +89,11 @@ def test_projection_weights_by_projected_length():
     np.testing.assert_allclose(lengths_xz, [1, 0.5, 1], atol=1e-15)
 
 
+_TWO_FIBERS = Network(
+    np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]]), [[0, 1], [0, 2]], np.zeros(3, bool), np.full(3, -1)
+)
+
+
 @pytest.mark.parametrize(
     "call, match",
     [
@@ -91,6 +103,13 @@ def test_projection_weights_by_projected_length():
         (lambda: orientation_tensor([0.1], [-1.0]), "non-negative"),
         (lambda: orientation_tensor([0.1], [0.0]), "sum to zero"),
         (lambda: anisotropy_index(np.eye(3)), "2x2"),
+        # used to give α = 150 %: H with a negative eigenvalue is no orientation tensor
+        (lambda: anisotropy_index(np.diag([-1.0, 2.0])), "positive semi-definite"),
+        # used to be silently symmetrised
+        (lambda: anisotropy_index([[0.5, 0.3], [0.0, 0.5]]), "symmetric"),
+        (lambda: mean_direction([[0.5, 0.3], [0.0, 0.5]]), "symmetric"),
+        (lambda: project(_TWO_FIBERS, normal=(0.0, 0.0, 0.0)), "non-zero 3-vector"),
+        (lambda: project(_TWO_FIBERS, normal=(0.0, 1.0)), "non-zero 3-vector"),
     ],
 )
 def test_bad_input(call, match):

@@ -25,6 +25,18 @@ def eq9(lam):
     )
 
 
+def interior_imbalance(network, result, fiber):
+    """(‖Σ fiber forces on interior nodes‖, ‖f‖), recomputed from the deformed nodes with Eq. 9."""
+    x = result.deformed_nodes
+    d = network.fiber_vectors(x)
+    ell = np.linalg.norm(d, axis=1)
+    f = fiber.force(ell / network.fiber_lengths())
+    net_force = np.zeros_like(x)
+    np.add.at(net_force, network.fibers[:, 0], f[:, None] * d / ell[:, None])
+    np.add.at(net_force, network.fibers[:, 1], -f[:, None] * d / ell[:, None])
+    return np.linalg.norm(net_force[~network.boundary]), np.linalg.norm(f)
+
+
 @pytest.fixture(scope="module")
 def fiber():
     return ExponentialFiber.from_diameter(E_F, DIAMETER, BETA, LAMBDA_C)
@@ -82,15 +94,9 @@ def test_interior_node_of_a_chain_finds_equal_stretch(fiber):
 def test_force_balance_residual(network, fiber):
     result = solve_rve(network, F_BIAXIAL, fiber)
     x = result.deformed_nodes
-    d = network.fiber_vectors(x)
-    ell = np.linalg.norm(d, axis=1)
-    f = fiber.force(ell / network.fiber_lengths())
-    net_force = np.zeros_like(x)
-    np.add.at(net_force, network.fibers[:, 0], f[:, None] * d / ell[:, None])
-    np.add.at(net_force, network.fibers[:, 1], -f[:, None] * d / ell[:, None])
+    imbalance, force_norm = interior_imbalance(network, result, fiber)
+    assert imbalance < 1e-10 * force_norm
     interior = ~network.boundary
-    relative = np.linalg.norm(net_force[interior]) / np.linalg.norm(f)
-    assert relative < 1e-10
     # the motion is genuinely non-affine
     assert np.abs(x[interior] - network.nodes[interior] @ F_BIAXIAL.T).max() > 1e-3
     # Eq. 8 summed over boundary cross-links equals the fiber virial
@@ -111,21 +117,43 @@ def test_objectivity(network, fiber):
     assert abs(spin.cauchy).max() < 1e-9 * abs(result.cauchy).max()
 
 
-def test_tangent_matches_finite_differences(network, fiber):
-    result = solve_rve(network, F_BIAXIAL, fiber)
-    h = 1e-6
+def fd_tangent(network, F, fiber, state=None, h=1e-6):
+    """Central differences of the equilibrated σ with respect to every F_pq."""
     fd = np.zeros((3, 3, 3, 3))
     for p in range(3):
         for q in range(3):
             dF = np.zeros((3, 3))
             dF[p, q] = h
-            plus = solve_rve(network, F_BIAXIAL + dF, fiber, state=result.state, tol=1e-12)
-            minus = solve_rve(network, F_BIAXIAL - dF, fiber, state=result.state, tol=1e-12)
+            plus = solve_rve(network, F + dF, fiber, state=state, tol=1e-12)
+            minus = solve_rve(network, F - dF, fiber, state=state, tol=1e-12)
             fd[:, :, p, q] = (plus.cauchy - minus.cauchy) / (2 * h)
-    error = abs(result.tangent - fd).max() / abs(fd).max()
-    assert error < 1e-6
-    # the affine (no-relaxation) part alone would be far off: the implicit term matters
-    assert abs(result.tangent).max() > 0
+    return fd
+
+
+def test_tangent_matches_finite_differences(network, fiber):
+    # h = 1e-6: truncation ~h² relative; force balance to 1e-12 leaves ~1e-12/h = 1e-6 relative
+    # noise at worst; a missing or wrong term is O(1e-2) or more (see the affine check below)
+    result = solve_rve(network, F_BIAXIAL, fiber)
+    fd = fd_tangent(network, F_BIAXIAL, fiber, state=result.state)
+    assert abs(result.tangent - fd).max() / abs(fd).max() < 1e-6
+    # the implicit (relaxation) term matters: the same network held affine (every node on the
+    # boundary) has a tangent that differs by far more than the tolerance above
+    affine_net = Network(network.nodes, network.fibers, np.ones(network.n_nodes, bool), network.face)
+    affine = solve_rve(affine_net, F_BIAXIAL, fiber)
+    assert abs(affine.tangent - fd).max() / abs(fd).max() > 1e-2
+    affine_fd = fd_tangent(affine_net, F_BIAXIAL, fiber)
+    assert abs(affine.tangent - affine_fd).max() < 1e-6 * abs(affine_fd).max()
+
+
+@pytest.mark.parametrize("compression", ["paper", "buckle"])
+def test_tangent_matches_finite_differences_in_compression(network, compression):
+    """Biaxial compression (many fibres below λ = 1, convexified Newton path) in both modes."""
+    fiber = ExponentialFiber.from_diameter(E_F, DIAMETER, BETA, LAMBDA_C, compression=compression)
+    F = np.array([[0.95, 0.02, 0.0], [0.0, 0.93, 0.01], [0.0, 0.0, 1.02]])
+    result = solve_rve(network, F, fiber, max_iter=100)
+    assert result.status == 0
+    fd = fd_tangent(network, F, fiber, state=result.state)
+    assert abs(result.tangent - fd).max() / abs(fd).max() < 1e-5
 
 
 def test_warm_start_and_batch_agree(network, fiber):
@@ -138,7 +166,12 @@ def test_warm_start_and_batch_agree(network, fiber):
     other = generate(27.0, 90.0, n_fibers=150, seed=2)
     batch = solve_rve_batch([network, other], np.stack([F2, F_BIAXIAL]), fiber, states=[cold.state, None])
     np.testing.assert_allclose(batch[0].cauchy, warm.cauchy, rtol=1e-12)
-    np.testing.assert_allclose(batch[1].cauchy, solve_rve(other, F_BIAXIAL, fiber).cauchy, rtol=1e-12)
+    np.testing.assert_allclose(batch[0].tangent, warm.tangent, rtol=1e-10, atol=1e-12 * abs(warm.tangent).max())
+    single = solve_rve(other, F_BIAXIAL, fiber)
+    np.testing.assert_allclose(batch[1].cauchy, single.cauchy, rtol=1e-12)
+    np.testing.assert_allclose(batch[1].tangent, single.tangent, rtol=1e-10, atol=1e-12 * abs(single.tangent).max())
+    np.testing.assert_array_equal(batch[1].fiber_stretch, single.fiber_stretch)
+    assert batch[1].deformed_nodes.shape == (other.n_nodes, 3)
 
 
 def test_large_cold_step_converges_and_diameter_cancels(network):
@@ -161,6 +194,21 @@ def test_bad_input(network, fiber):
         solve_rve(network, np.eye(2), fiber)
     with pytest.raises(ValueError, match="state"):
         solve_rve(network, np.eye(3), fiber, state=RVEState(np.zeros((2, 3)), np.eye(3), np.zeros((1, 9))))
+    with pytest.raises(ValueError, match="finite"):
+        solve_rve(network, np.full((3, 3), np.nan), fiber)
+    with pytest.raises(ValueError, match=r"shape \(3, 3\)"):
+        solve_rve(network, np.eye(3)[:, :, None], fiber)
+    for diameter in (-450e-9, 0.0, np.nan):  # a negative diameter used to pass (π d²/4 > 0)
+        with pytest.raises(ValueError, match="fiber_diameter"):
+            solve_rve(network, np.eye(3), fiber, fiber_diameter=diameter)
+    with pytest.raises(ValueError, match="tol"):
+        solve_rve(network, np.eye(3), fiber, tol=-1.0)
+    with pytest.raises(TypeError, match="ExponentialFiber"):
+        solve_rve(network, np.eye(3), "fiber")
+    with pytest.raises(ValueError, match="3 states for 2 networks"):
+        solve_rve_batch([network, network], np.stack([np.eye(3)] * 2), fiber, states=[None] * 3)
+    with pytest.raises(ValueError, match=r"shape \(2, 3, 3\)"):
+        solve_rve_batch([network, network], np.eye(3), fiber)
 
 
 @pytest.mark.parametrize("compression", ["paper", "buckle"])
@@ -169,15 +217,9 @@ def test_compressed_network_converges(network, compression):
     fiber = ExponentialFiber.from_diameter(E_F, DIAMETER, BETA, LAMBDA_C, compression=compression)
     result = solve_rve(network, np.diag([0.9, 0.9, 1.0]), fiber, max_iter=100)
     assert result.status == 0
-    x = result.deformed_nodes
-    d = network.fiber_vectors(x)
-    ell = np.linalg.norm(d, axis=1)
-    f = fiber.force(ell / network.fiber_lengths())
-    net_force = np.zeros_like(x)
-    np.add.at(net_force, network.fibers[:, 0], f[:, None] * d / ell[:, None])
-    np.add.at(net_force, network.fibers[:, 1], -f[:, None] * d / ell[:, None])
+    imbalance, force_norm = interior_imbalance(network, result, fiber)
     # balanced to 1e-8 of the (small, compressive) fiber forces
-    assert np.linalg.norm(net_force[~network.boundary]) < 1e-8 * np.linalg.norm(f)
+    assert imbalance < 1e-8 * force_norm
     assert result.cauchy[0, 0] < 0 and result.cauchy[1, 1] < 0
 
 

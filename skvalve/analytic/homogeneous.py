@@ -87,6 +87,11 @@ def _root_in_log(fun, guess: float, what: str) -> float:
 
 
 def _check_mode(material, incompressible: bool) -> None:
+    if not callable(getattr(material, "cauchy", None)):
+        raise TypeError(
+            "material must be a continuum law with a cauchy(F) method (skvalve.materials); "
+            f"got {type(material).__name__}"
+        )
     if not incompressible and getattr(material, "incompressible", False):
         raise ValueError(
             f"{type(material).__name__} is incompressible: its stress is defined only up to a pressure, "
@@ -95,8 +100,8 @@ def _check_mode(material, incompressible: bool) -> None:
 
 
 def _assemble(stretch_list: list[Array], stress_list: list[Array], shape: tuple[int, ...]) -> HomogeneousResponse:
-    stretches = np.stack(stretch_list, axis=-1).reshape((3,) + shape)
-    cauchy = np.stack(stress_list, axis=-1).reshape((3,) + shape)
+    stretches = np.stack(stretch_list, axis=-1).reshape((3,) + shape) if stretch_list else np.empty((3,) + shape)
+    cauchy = np.stack(stress_list, axis=-1).reshape((3,) + shape) if stress_list else np.empty((3,) + shape)
     J = np.prod(stretches, axis=0)
     return HomogeneousResponse(stretches=stretches, J=J, cauchy=cauchy, nominal=J * cauchy / stretches)
 
@@ -148,7 +153,11 @@ def uniaxial(material, stretch: ArrayLike, incompressible: bool = True) -> Homog
 def biaxial(material, stretch1: ArrayLike, stretch2: ArrayLike, incompressible: bool = True) -> HomogeneousResponse:
     r"""Planar biaxial stretch :math:`(\lambda_1, \lambda_2)` of a thin sheet, :math:`\sigma_{33} = 0`."""
     _check_mode(material, incompressible)
-    s1, s2 = np.broadcast_arrays(_positive_stretches("stretch1", stretch1), _positive_stretches("stretch2", stretch2))
+    s1, s2 = _positive_stretches("stretch1", stretch1), _positive_stretches("stretch2", stretch2)
+    try:
+        s1, s2 = np.broadcast_arrays(s1, s2)
+    except ValueError:
+        raise ValueError(f"stretch1 of shape {s1.shape} and stretch2 of shape {s2.shape} do not broadcast") from None
     stretch_list, stress_list = [], []
     for lam1, lam2 in zip(s1.ravel(), s2.ravel(), strict=True):
         if incompressible:

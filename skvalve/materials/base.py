@@ -35,6 +35,18 @@ from ..kinematics import Array, as_tensor_field, determinant, right_cauchy_green
 __all__ = ["Hyperelastic", "VolumetricEnergy", "check_positive", "check_nonnegative"]
 
 
+def _first_index(mask: Array) -> tuple[int, ...]:
+    """Batch index of the first True entry of ``mask`` (``()`` for a 0-d mask)."""
+    mask = np.asarray(mask)
+    if mask.ndim == 0:
+        return ()
+    return tuple(int(i) for i in np.argwhere(mask)[0])
+
+
+def _at(index: tuple[int, ...]) -> str:
+    return f" at batch index {index}" if index else ""
+
+
 def check_positive(name: str, value: float) -> float:
     """Return ``float(value)`` or raise ``ValueError`` naming the parameter."""
     value = float(value)
@@ -68,21 +80,27 @@ class VolumetricEnergy:
         if self.kind not in ("quadratic", "log"):
             raise ValueError(f"VolumetricEnergy kind must be 'quadratic' or 'log'; got {self.kind!r}")
 
-    def energy(self, J: ArrayLike) -> Array:
+    def _jacobian(self, J: ArrayLike) -> Array:
         J = np.asarray(J, dtype=float)
+        if self.kind == "log" and not np.all(J > 0.0):
+            raise ValueError(f"VolumetricEnergy(kind='log'): J must be positive; got min J = {float(np.min(J))!r}")
+        return J
+
+    def energy(self, J: ArrayLike) -> Array:
+        J = self._jacobian(J)
         if self.kind == "quadratic":
             return 0.5 * self.modulus * (J - 1.0) ** 2
         return 0.5 * self.modulus * np.log(J) ** 2
 
     def first_derivative(self, J: ArrayLike) -> Array:
         """:math:`U'(J)`, the hydrostatic pressure magnitude (tension positive)."""
-        J = np.asarray(J, dtype=float)
+        J = self._jacobian(J)
         if self.kind == "quadratic":
             return self.modulus * (J - 1.0)
         return self.modulus * np.log(J) / J
 
     def second_derivative(self, J: ArrayLike) -> Array:
-        J = np.asarray(J, dtype=float)
+        J = self._jacobian(J)
         if self.kind == "quadratic":
             return np.full_like(J, self.modulus)
         return self.modulus * (1.0 - np.log(J)) / J**2
@@ -118,22 +136,23 @@ class Hyperelastic(ABC):
     # --------------------------------------------------- derived, in terms of F
     def psi(self, F: ArrayLike) -> Array:
         """Strain energy per unit reference volume at deformation gradients ``F``."""
-        return self.energy_C(self._C(F))
+        F = as_tensor_field(F)
+        return self._checked("psi", self.energy_C(self._C(F)), F.shape[2:])
 
     def pk2(self, F: ArrayLike) -> Array:
         """Second Piola–Kirchhoff stress, shape (3, 3, *batch)."""
-        return self.stress_C(self._C(F))
+        F = as_tensor_field(F)
+        return self._checked("pk2", self.stress_C(self._C(F)), F.shape[2:])
 
     def pk1(self, F: ArrayLike) -> Array:
         """First Piola–Kirchhoff stress :math:`P = F S`, shape (3, 3, *batch)."""
         F = as_tensor_field(F)
-        return np.einsum("iI...,IJ...->iJ...", F, self.stress_C(self._C(F)))
+        return np.einsum("iI...,IJ...->iJ...", F, self.pk2(F))
 
     def cauchy(self, F: ArrayLike) -> Array:
         r"""Cauchy stress :math:`\sigma = J^{-1} F S F^T`, shape (3, 3, *batch)."""
         F = as_tensor_field(F)
-        S = self.stress_C(self._C(F))
-        return np.einsum("iI...,IJ...,jJ...->ij...", F, S, F) / determinant(F)
+        return np.einsum("iI...,IJ...,jJ...->ij...", F, self.pk2(F), F) / determinant(F)
 
     def tangent(self, F: ArrayLike) -> Array:
         r"""First elasticity tensor :math:`\partial P_{iJ}/\partial F_{kL}`, shape (3,3,3,3,*batch)."""
@@ -143,6 +162,8 @@ class Hyperelastic(ABC):
         """``(P, dP/dF)`` sharing the work of one constitutive evaluation."""
         F = as_tensor_field(F)
         S, CC = self.response_C(self._C(F))
+        self._checked("pk2", S, F.shape[2:])
+        self._checked("elasticity tensor", CC, F.shape[2:])
         P = np.einsum("iI...,IJ...->iJ...", F, S)
         FCC = np.einsum("iI...,IJKL...->iJKL...", F, CC)
         A = np.einsum("kK...,iJKL...->iJkL...", F, FCC)
@@ -152,15 +173,29 @@ class Hyperelastic(ABC):
 
     # ----------------------------------------------------------------- helpers
     def _C(self, F: ArrayLike) -> Array:
+        """C = FᵀF after checking that F is finite with det F > 0 (``ValueError`` naming the point)."""
         F = as_tensor_field(F)
+        finite = np.all(np.isfinite(F), axis=(0, 1))
+        if not np.all(finite):
+            raise ValueError(f"{type(self).__name__}: F must be finite; got NaN or inf{_at(_first_index(~finite))}")
         J = determinant(F)
-        if np.any(~(J > 0.0)):
-            idx = np.argwhere(np.atleast_1d(~(J > 0.0)))[0]
+        if np.any(J <= 0.0):
+            idx = _first_index(J <= 0.0)
             raise ValueError(
-                f"{type(self).__name__}: det F must be positive; got {np.atleast_1d(J)[tuple(idx)]!r} "
-                f"at batch index {tuple(int(i) for i in idx)}"
+                f"{type(self).__name__}: det F must be positive; got {float(np.asarray(J)[idx])!r}{_at(idx)}"
             )
         return right_cauchy_green(F)
+
+    def _checked(self, what: str, value: Array, batch_shape: tuple[int, ...]) -> Array:
+        """``value`` (tensor axes first, then ``batch_shape``) or ``ValueError`` where it overflowed."""
+        bad = ~np.isfinite(value)
+        if np.any(bad):
+            where = _first_index(bad.reshape((-1,) + batch_shape).any(axis=0))
+            raise ValueError(
+                f"{type(self).__name__}: {what} overflows (inf or NaN){_at(where)}; "
+                "the deformation is outside the range this law can be evaluated in"
+            )
+        return value
 
     def parameters(self) -> dict[str, object]:
         """The law's parameters by name (dataclass fields)."""

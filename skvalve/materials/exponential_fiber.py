@@ -38,14 +38,16 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike
 
+from .base import check_positive
+
 _COMPRESSION_MODES = ("paper", "buckle")
 
 
 def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value) or value <= 0.0:
-        raise ValueError(f"ExponentialFiber: {name} must be a positive finite number, got {value}")
-    return value
+    try:
+        return check_positive(name, value)
+    except ValueError as err:
+        raise ValueError(f"ExponentialFiber: {err}") from None
 
 
 class ExponentialFiber:
@@ -110,27 +112,36 @@ class ExponentialFiber:
     def _checked(self, stretch: ArrayLike) -> np.ndarray:
         lam = np.asarray(stretch, dtype=float)
         if not np.all(np.isfinite(lam)) or np.any(lam <= 0.0):
-            raise ValueError("ExponentialFiber: stretch must be finite and > 0")
+            bad = np.atleast_1d(lam)[~(np.isfinite(np.atleast_1d(lam)) & (np.atleast_1d(lam) > 0.0))][0]
+            raise ValueError(f"ExponentialFiber: stretch must be finite and > 0; got {float(bad)!r}")
         return lam
+
+    def _scaled(self, what: str, lam: np.ndarray, normalized: np.ndarray) -> np.ndarray:
+        """E_f A_f times the kernel output, or ``ValueError`` where exp(β e_G) overflowed."""
+        if not np.all(np.isfinite(normalized)):
+            bad = lam.ravel()[~np.isfinite(normalized)][0]
+            raise ValueError(
+                f"ExponentialFiber: {what} overflows at stretch {float(bad)!r} "
+                f"(exp(beta e_G) beyond float range for beta = {self.beta:g})"
+            )
+        return self.axial_rigidity * normalized.reshape(lam.shape)
 
     def force(self, stretch: ArrayLike) -> np.ndarray:
         """Axial force f(λ), Eq. 9 (same units as E_f A_f)."""
         lam = self._checked(stretch)
-        force, _ = _evaluate(lam.ravel(), self.parameters())
-        return self.axial_rigidity * force.reshape(lam.shape)
+        return self._scaled("force", lam, _evaluate(lam.ravel(), self.parameters())[0])
 
     def stiffness(self, stretch: ArrayLike) -> np.ndarray:
         """Tangent stiffness df/dλ of Eq. 9."""
         lam = self._checked(stretch)
-        _, stiffness = _evaluate(lam.ravel(), self.parameters())
-        return self.axial_rigidity * stiffness.reshape(lam.shape)
+        return self._scaled("stiffness", lam, _evaluate(lam.ravel(), self.parameters())[1])
 
     def energy(self, stretch: ArrayLike) -> np.ndarray:
         """Stored energy per unit rest length, W(λ) = ∫₁^λ f dλ' (units of E_f A_f)."""
         lam = self._checked(stretch)
         params = self.parameters()
         flat = np.array([normalized_energy(value, params) for value in lam.ravel()])
-        return self.axial_rigidity * flat.reshape(lam.shape)
+        return self._scaled("energy", lam, flat)
 
     def __repr__(self) -> str:
         return (

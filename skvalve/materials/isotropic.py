@@ -29,7 +29,7 @@ import numpy as np
 from ..kinematics import Array, determinant, identity_like, inverse
 from .base import Hyperelastic
 
-__all__ = ["IsotropicInvariantLaw", "Partials"]
+__all__ = ["IsotropicInvariantLaw", "Partials", "outer", "jacobian_second_derivative"]
 
 
 class Partials(NamedTuple):
@@ -43,8 +43,19 @@ class Partials(NamedTuple):
     d_JJ: Array
 
 
-def _outer(A: Array, B: Array) -> Array:
+def outer(A: Array, B: Array) -> Array:
+    r"""Dyadic product :math:`(A\otimes B)_{IJKL} = A_{IJ} B_{KL}` of tensor fields."""
     return np.einsum("IJ...,KL...->IJKL...", A, B)
+
+
+def jacobian_second_derivative(J: Array, G: Array) -> tuple[Array, Array, Array]:
+    r"""``(G⊗G, 𝔾, ∂²J/∂C²)`` with :math:`\partial^2 J/\partial C^2 = \tfrac J4 G\otimes G - \tfrac J2 \mathbb{G}`.
+
+    :math:`G = C^{-1}` and :math:`\mathbb{G}_{IJKL} = \tfrac12 (G_{IK}G_{JL} + G_{IL}G_{JK})`.
+    """
+    GG = outer(G, G)
+    Gsym = 0.5 * (np.einsum("IK...,JL...->IJKL...", G, G) + np.einsum("IL...,JK...->IJKL...", G, G))
+    return GG, Gsym, 0.25 * J * GG - 0.5 * J * Gsym
 
 
 class IsotropicInvariantLaw(Hyperelastic):
@@ -80,18 +91,12 @@ class IsotropicInvariantLaw(Hyperelastic):
         J, G, I1bar, Jm23, eye, dI, dJ = self._kinematic_terms(C)
         p = self.partials(I1bar, J, C)
         S = 2.0 * (p.d_I * dI + p.d_J * dJ)
-        GG = _outer(G, G)
-        Gsym = 0.5 * (np.einsum("IK...,JL...->IJKL...", G, G) + np.einsum("IL...,JK...->IJKL...", G, G))
-        d2J = 0.25 * J * GG - 0.5 * J * Gsym
-        d2I = (
-            -Jm23 / 3.0 * (_outer(eye, G) + _outer(G, eye))
-            + I1bar / 9.0 * GG
-            + I1bar / 3.0 * Gsym
-        )
+        GG, Gsym, d2J = jacobian_second_derivative(J, G)
+        d2I = -Jm23 / 3.0 * (outer(eye, G) + outer(G, eye)) + I1bar / 9.0 * GG + I1bar / 3.0 * Gsym
         CC = 4.0 * (
-            p.d_II * _outer(dI, dI)
-            + p.d_IJ * (_outer(dI, dJ) + _outer(dJ, dI))
-            + p.d_JJ * _outer(dJ, dJ)
+            p.d_II * outer(dI, dI)
+            + p.d_IJ * (outer(dI, dJ) + outer(dJ, dI))
+            + p.d_JJ * outer(dJ, dJ)
             + p.d_I * d2I
             + p.d_J * d2J
         )

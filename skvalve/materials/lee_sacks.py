@@ -50,6 +50,8 @@ class LeeSacks(IsotropicInvariantLaw):
         check_nonnegative("c2", self.c2)
         if self.D is not None:
             check_positive("D", self.D)
+        if not isinstance(self.published_equation, (bool, np.bool_)):
+            raise ValueError(f"parameter published_equation must be True or False; got {self.published_equation!r}")
 
     @property
     def incompressible(self) -> bool:  # type: ignore[override]

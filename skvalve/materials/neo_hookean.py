@@ -48,9 +48,7 @@ class NeoHookean(IsotropicInvariantLaw):
         check_positive("mu", self.mu)
         # A negative lambda is admissible down to nu > -1, i.e. lambda > -2 mu / 3.
         if not (np.isfinite(self.lmbda) and self.lmbda > -2.0 * self.mu / 3.0):
-            raise ValueError(
-                f"parameter lmbda must exceed -2 mu / 3 (positive bulk modulus); got {self.lmbda!r}"
-            )
+            raise ValueError(f"parameter lmbda must exceed -2 mu / 3 (positive bulk modulus); got {self.lmbda!r}")
 
     @classmethod
     def from_shear_poisson(cls, G: float, nu: float) -> NeoHookean:

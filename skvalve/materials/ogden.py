@@ -26,7 +26,7 @@ J^{-\alpha/3}\operatorname{tr}C^{\alpha/2}`, so each term is
 with :math:`J_{,C} = \tfrac J2 C^{-1}`, :math:`J_{,CC}` as in :mod:`.isotropic` and
 :math:`T_{,C}, T_{,CC}` from the Daleckii–Krein formula of :mod:`._spectral`, which is exact
 at coincident principal stretches (F = I, F = diag(a, a, b), F = aR).
-``D = ()`` means incompressible: only the isochoric part, ``incompressible = True``; the
+``D = ()`` (or ``None``) means incompressible: only the isochoric part, ``incompressible = True``; the
 total stress is then :math:`\sigma_\text{law} - pI` (see :mod:`.base`).
 """
 
@@ -40,12 +40,9 @@ import numpy as np
 from ..kinematics import Array, determinant, inverse
 from ._spectral import symmetric_eigen, trace_power_derivatives
 from .base import Hyperelastic, VolumetricEnergy, check_positive
+from .isotropic import jacobian_second_derivative, outer
 
 __all__ = ["Ogden"]
-
-
-def _outer(A: Array, B: Array) -> Array:
-    return np.einsum("IJ...,KL...->IJKL...", A, B)
 
 
 def _as_parameter_tuple(name: str, values: float | Sequence[float]) -> tuple[float, ...]:
@@ -68,7 +65,7 @@ class Ogden(Hyperelastic):
     def __post_init__(self) -> None:
         mu = _as_parameter_tuple("mu", self.mu)
         alpha = _as_parameter_tuple("alpha", self.alpha)
-        D = () if len(np.atleast_1d(self.D)) == 0 else _as_parameter_tuple("D", self.D)
+        D = () if self.D is None or len(np.atleast_1d(self.D)) == 0 else _as_parameter_tuple("D", self.D)
         if len(mu) == 0:
             raise ValueError("parameter mu must hold at least one Ogden term")
         if len(mu) != len(alpha):
@@ -147,10 +144,8 @@ class Ogden(Hyperelastic):
         _, dU, d2U = self._volumetric(J)
         dpsi = dU * dJ
         if with_tangent:
-            GG = _outer(G, G)
-            Gsym = 0.5 * (np.einsum("IK...,JL...->IJKL...", G, G) + np.einsum("IL...,JK...->IJKL...", G, G))
-            d2J = 0.25 * J * GG - 0.5 * J * Gsym
-            d2psi = d2U * _outer(dJ, dJ) + dU * d2J
+            d2J = jacobian_second_derivative(J, G)[2]
+            d2psi = d2U * outer(dJ, dJ) + dU * d2J
         for m, a in zip(self.mu, self.alpha, strict=True):
             c = 2.0 * m / a**2
             K = J ** (-a / 3.0)
@@ -160,7 +155,7 @@ class Ogden(Hyperelastic):
             dpsi = dpsi + c * (dK * T * dJ + K * dT)
             if with_tangent:
                 d2psi = d2psi + c * (
-                    d2K * T * _outer(dJ, dJ) + dK * T * d2J + dK * (_outer(dJ, dT) + _outer(dT, dJ)) + K * d2T
+                    d2K * T * outer(dJ, dJ) + dK * T * d2J + dK * (outer(dJ, dT) + outer(dT, dJ)) + K * d2T
                 )
         return 2.0 * dpsi, (4.0 * d2psi if with_tangent else None)
 

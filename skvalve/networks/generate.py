@@ -165,8 +165,15 @@ def generate(
         raise ValueError(f"generate: alpha must be in [0, 95) percent, got {alpha}")
     if not np.isfinite(mu):
         raise ValueError(f"generate: mu must be finite, got {mu}")
-    if n_fibers < 20:
-        raise ValueError(f"generate: n_fibers must be >= 20, got {n_fibers}")
+    if isinstance(n_fibers, bool) or not isinstance(n_fibers, (int, np.integer)) or n_fibers < 20:
+        raise ValueError(f"generate: n_fibers must be an integer >= 20, got {n_fibers!r}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"generate: seed must be a non-negative integer, got {seed!r}")
+    for name, value in (("alpha_tol", alpha_tol), ("mu_tol", mu_tol)):
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"generate: {name} must be positive and finite, got {value!r}")
+    if int(max_attempts) < 1:
+        raise ValueError(f"generate: max_attempts must be >= 1, got {max_attempts!r}")
     density = n_fibers / FIBERS_PER_POINT  # interior points per unit volume in the final cube
     n_max = int(round(8.0 * density * MAX_STRETCH * DENSITY_HEADROOM))
     check_mu = alpha >= 10.0
@@ -193,7 +200,8 @@ def generate(
                 break  # already too aligned at s = 1: try another sub-seed
             stretch = 0.5 * (lo + hi)
         mu_error = (m - mu + 90.0) % 180.0 - 90.0
-        if abs(a - alpha) <= alpha_tol and (not check_mu or abs(mu_error) <= mu_tol):
+        count_ok = abs(network.n_fibers / n_fibers - 1.0) <= 0.1  # the loop may end on a count correction
+        if count_ok and abs(a - alpha) <= alpha_tol and (not check_mu or abs(mu_error) <= mu_tol):
             network.meta.update(
                 alpha_target=float(alpha),
                 mu_target=float(mu),

@@ -1,8 +1,8 @@
 """Seeded, cached library of networks over an α/μ grid (Thomas 2019 section 2.3, "library of
 network files").  Each network is generated once by :func:`generate` and stored as ``.npz``
 in a user cache directory (``$SKVALVE_CACHE/networks`` if set, else ``~/.cache/skvalve/networks``),
-never inside the package.  File names encode every generation input, so a cache hit returns
-exactly what ``generate`` would.
+never inside the package.  File names encode every generation input (α and μ to 0.01; the exact
+targets are checked against the stored metadata), so a cache hit returns exactly what ``generate`` would.
 """
 
 from __future__ import annotations
@@ -37,7 +37,10 @@ def cached_network(
     folder = Path(directory) if directory is not None else cache_dir()
     path = folder / network_file(alpha, mu, n_fibers, seed)
     if path.exists():
-        return Network.load(path)
+        cached = Network.load(path)
+        # the file name rounds α and μ to 0.01: serve the file only if it was made for these exact targets
+        if cached.meta.get("alpha_target") == float(alpha) and cached.meta.get("mu_target") == float(mu):
+            return cached
     network = generate(alpha, mu, n_fibers=n_fibers, seed=seed)
     folder.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".tmp.npz")

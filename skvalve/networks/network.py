@@ -41,6 +41,8 @@ class Network:
         n = len(self.nodes)
         if self.nodes.ndim != 2 or self.nodes.shape[1] != 3:
             raise ValueError(f"Network.nodes must have shape (n, 3), got {self.nodes.shape}")
+        if not np.all(np.isfinite(self.nodes)):
+            raise ValueError("Network.nodes must be finite (found NaN or inf)")
         if self.fibers.ndim != 2 or self.fibers.shape[1] != 2:
             raise ValueError(f"Network.fibers must have shape (m, 2), got {self.fibers.shape}")
         if self.boundary.shape != (n,) or self.face.shape != (n,):

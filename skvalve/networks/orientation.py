@@ -51,10 +51,18 @@ def orientation_tensor(angles: ArrayLike, weights: ArrayLike | None = None) -> n
     return np.array([[h11, h12], [h12, h22]]) / total
 
 
-def _check_tensor(H: np.ndarray) -> np.ndarray:
+def _check_tensor(H: ArrayLike) -> np.ndarray:
+    """H as a symmetric positive semi-definite 2×2 array, or ``ValueError`` saying what is wrong."""
     H = np.asarray(H, dtype=float)
     if H.shape != (2, 2) or not np.all(np.isfinite(H)):
         raise ValueError(f"orientation tensor must be a finite 2x2 array, got shape {H.shape}")
+    scale = np.max(np.abs(H))
+    if abs(H[0, 1] - H[1, 0]) > 1e-12 * scale:
+        raise ValueError(
+            f"orientation tensor must be symmetric (Eq. 1), got H12 = {float(H[0, 1])!r} != H21 = {float(H[1, 0])!r}"
+        )
+    if np.linalg.eigvalsh(H)[0] < -1e-12 * scale:
+        raise ValueError("orientation tensor must be positive semi-definite (Eq. 1: a mean of r ⊗ r)")
     return 0.5 * (H + H.T)
 
 
@@ -67,7 +75,11 @@ def anisotropy_index(H: ArrayLike) -> float:
 
 
 def mean_direction(H: ArrayLike) -> float:
-    """μ in degrees in (−90, 90]: direction of the major eigenvector, Eq. 3."""
+    """μ in degrees in (−90, 90]: direction of the major eigenvector, Eq. 3.
+
+    For an isotropic H (α = 0) every direction is a major one and μ is meaningless; the
+    value returned then is that of the eigen-solver's choice (90° for H = I/2).
+    """
     _, vectors = np.linalg.eigh(_check_tensor(H))
     major = vectors[:, 1]
     mu = np.degrees(np.arctan2(major[1], major[0]))

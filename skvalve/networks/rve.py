@@ -94,12 +94,18 @@ def _check_F(F: np.ndarray, where: str) -> np.ndarray:
 
 def _scale(network: Network, fiber: ExponentialFiber, psi: float, diameter: float | None):
     """(ψ E_f A_f /(L A_f,Eq8), γ): Eq. 8 prefactor for forces normalised by E_f A_f."""
+    if not isinstance(network, Network):
+        raise TypeError(f"solve_rve: network must be a skvalve.networks.Network, got {type(network).__name__}")
+    if not isinstance(fiber, ExponentialFiber):
+        raise TypeError(f"solve_rve: fiber must be an ExponentialFiber, got {type(fiber).__name__}")
     if not (0.0 < psi <= 1.0):
         raise ValueError(f"solve_rve: psi (fiber volume fraction) must be in (0, 1], got {psi}")
+    if diameter is not None and not (math.isfinite(float(diameter)) and float(diameter) > 0.0):
+        raise ValueError(f"solve_rve: fiber_diameter must be positive and finite, got {diameter}")
     area = fiber.A_f if diameter is None else math.pi * float(diameter) ** 2 / 4.0
-    if not area > 0:
-        raise ValueError(f"solve_rve: fiber_diameter must be positive, got {diameter}")
     length = network.total_length
+    if not length > 0.0:
+        raise ValueError("solve_rve: the network has no fibers (total length 0)")
     return psi * fiber.axial_rigidity / (length * area), math.sqrt(length * area / psi)
 
 
@@ -121,10 +127,14 @@ class RVEBatch:
     ) -> None:
         if len(networks) == 0:
             raise ValueError("RVEBatch: no networks given")
+        if not (math.isfinite(tol) and tol > 0.0):
+            raise ValueError(f"RVEBatch: tol must be positive and finite, got {tol}")
+        if int(max_iter) < 1:
+            raise ValueError(f"RVEBatch: max_iter must be >= 1, got {max_iter}")
         self.networks = list(networks)
+        scales = [_scale(net, fiber, psi, fiber_diameter) for net in self.networks]
         self.fiber, self.params = fiber, fiber.parameters()
         self.tol, self.max_iter = float(tol), int(max_iter)
-        scales = [_scale(net, fiber, psi, fiber_diameter) for net in self.networks]
         self.scale = np.array([s for s, _ in scales])
         self.edge_length = np.array([g for _, g in scales])
         n_nodes = [net.n_nodes for net in self.networks]
@@ -243,6 +253,22 @@ class RVEBatch:
         out["sensitivity"] = sensitivity
         return out
 
+    def result(self, r: int, out: dict) -> RVEResult:
+        """RVE ``r`` of the arrays returned by :meth:`solve`, with its current state."""
+        n0, n1 = self.node_start[r], self.node_start[r + 1]
+        m0, m1 = self.fiber_start[r], self.fiber_start[r + 1]
+        return RVEResult(
+            cauchy=out["cauchy"][r],
+            tangent=out["tangent"][r],
+            fiber_stretch=out["stretch"][m0:m1],
+            state=self.get_state(r),
+            deformed_nodes=out["x"][n0:n1],
+            iterations=int(out["iterations"][r]),
+            residual=float(out["residual"][r]),
+            status=int(out["status"][r]),
+            rve_edge_length=float(self.edge_length[r]),
+        )
+
     def _network_arrays(self, r: int) -> tuple:
         n0, n1 = self.node_start[r], self.node_start[r + 1]
         m0, m1 = self.fiber_start[r], self.fiber_start[r + 1]
@@ -312,20 +338,12 @@ def solve_rve(
     ``fiber_diameter`` sets A_f in Eq. 8 and γ in Eq. 7 (None: use ``fiber.A_f``).
     ``state`` from a previous result warm-starts the Newton iteration.
     """
+    F = np.asarray(F, dtype=float)
+    if F.shape != (3, 3):
+        raise ValueError(f"solve_rve: F must have shape (3, 3), got {F.shape} (use solve_rve_batch for many)")
     batch = RVEBatch([network], fiber, psi, fiber_diameter, tol, max_iter)
     batch.set_state(0, state)
-    out = batch.solve(np.asarray(F, dtype=float)[None])
-    return RVEResult(
-        cauchy=out["cauchy"][0],
-        tangent=out["tangent"][0],
-        fiber_stretch=out["stretch"],
-        state=batch.get_state(0),
-        deformed_nodes=out["x"],
-        iterations=int(out["iterations"][0]),
-        residual=float(out["residual"][0]),
-        status=int(out["status"][0]),
-        rve_edge_length=float(batch.edge_length[0]),
-    )
+    return batch.result(0, batch.solve(F[None]))
 
 
 def solve_rve_batch(
@@ -339,27 +357,13 @@ def solve_rve_batch(
 ) -> list[RVEResult]:
     """:func:`solve_rve` for many (network, F) pairs in one parallel numba call."""
     batch = RVEBatch(networks, fiber, psi, fiber_diameter, tol)
-    for r, state in enumerate(states or []):
+    states = [] if states is None else list(states)
+    if len(states) not in (0, len(batch.networks)):
+        raise ValueError(f"solve_rve_batch: {len(states)} states for {len(batch.networks)} networks")
+    for r, state in enumerate(states):
         batch.set_state(r, state)
     out = batch.solve(np.asarray(F, dtype=float))
-    results = []
-    for r in range(len(batch.networks)):
-        n0, n1 = batch.node_start[r], batch.node_start[r + 1]
-        m0, m1 = batch.fiber_start[r], batch.fiber_start[r + 1]
-        results.append(
-            RVEResult(
-                out["cauchy"][r],
-                out["tangent"][r],
-                out["stretch"][m0:m1],
-                batch.get_state(r),
-                out["x"][n0:n1],
-                int(out["iterations"][r]),
-                float(out["residual"][r]),
-                int(out["status"][r]),
-                float(batch.edge_length[r]),
-            )
-        )
-    return results
+    return [batch.result(r, out) for r in range(len(batch.networks))]
 
 
 def boundary_stress(
@@ -378,6 +382,6 @@ def boundary_stress(
     np.add.at(reaction, network.fibers[:, 1], force)  # fiber pulls its end b back: boundary
     np.add.at(reaction, network.fibers[:, 0], -force)  # holds it with +f e (and a with −f e)
     volume = np.linalg.det(result.state.F)
-    area = fiber.A_f if fiber_diameter is None else math.pi * fiber_diameter**2 / 4
+    prefactor = _scale(network, fiber, psi, fiber_diameter)[0] / fiber.axial_rigidity  # ψ / (L A_f)
     b = network.boundary
-    return psi / (network.total_length * area * volume) * x[b].T @ reaction[b]
+    return prefactor / volume * x[b].T @ reaction[b]
