@@ -1,0 +1,147 @@
+r"""Loads and constraints: prescribed displacements, follower pressure, nodal forces.
+
+**Follower pressure.** A pressure :math:`p` acting on the deformed surface does the virtual
+work :math:`-\int_\gamma p\,n\cdot\delta u\,da`. By Nanson's formula
+:math:`n\,da = \operatorname{cof}F\,N\,dA` it is an integral over the reference facets,
+and its contribution to the residual (internal minus external forces) and its
+linearisation are
+
+.. math::
+
+    R_{ai} \mathrel{+}= \int_{\Gamma_0} p\,N_a\,(\operatorname{cof}F)_{iJ} N_J\,dA, \qquad
+    K_{ai,bk} \mathrel{+}= \int_{\Gamma_0} p\,N_a\,\varepsilon_{ikm}\varepsilon_{JLM}F_{mM}N_J\,
+    \frac{\partial N_b}{\partial X_L}\,dA,
+
+from :math:`\partial(\operatorname{cof}F)_{iJ}/\partial F_{kL} = \varepsilon_{ikm}\varepsilon_{JLM}F_{mM}`
+(polynomial, no division by :math:`J`). The load stiffness is not symmetric in general
+(it is for closed surfaces and pressure fixed). Plane strain uses the same formula with
+:math:`F_{33} = 1` and :math:`N_3 = 0`. Only tangential derivatives enter
+:math:`\operatorname{cof}F\,N`, so the cell gradients evaluated on the facet are exact.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import skfem as fem
+
+from .kernels import element_gradients
+from .space import Space
+
+__all__ = ["Dirichlet", "FollowerPressure", "NodalForce", "load_function", "embed_3d"]
+
+_LEVI_CIVITA = np.zeros((3, 3, 3))
+for _i, _j, _k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
+    _LEVI_CIVITA[_i, _j, _k], _LEVI_CIVITA[_i, _k, _j] = 1.0, -1.0
+
+
+def load_function(value, ramp: bool = True, name: str = "load") -> Callable[[float], np.ndarray]:
+    """``t -> value * t`` (ramped), ``t -> value`` (fixed) or the callable itself."""
+    if callable(value):
+        return value
+    array = np.asarray(value, dtype=float)
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must be finite; got {value!r}")
+    return (lambda t: array * t) if ramp else (lambda t: array)
+
+
+def embed_3d(H: np.ndarray) -> np.ndarray:
+    """Deformation gradient (3, 3, ...) from a displacement gradient (d, d, ...), F33 = 1 in 2D."""
+    dim = H.shape[0]
+    F = np.zeros((3, 3) + H.shape[2:])
+    F[:dim, :dim] = H
+    for i in range(3):
+        F[i, i] += 1.0
+    return F
+
+
+class Dirichlet:
+    """Prescribed displacement components on a set of scalar dofs (nodes)."""
+
+    def __init__(self, space: Space, scalar_dofs: np.ndarray, components, value, ramp: bool) -> None:
+        self.components = np.atleast_1d(np.arange(space.dim) if components is None else np.asarray(components))
+        self.dofs = space.displacement_dofs(scalar_dofs, self.components)  # (ncomp, n)
+        self.coordinates = space.dof_coordinates[:, scalar_dofs]
+        self.dim = space.dim
+        self.value, self.ramp = value, ramp
+        if not callable(value):
+            array = np.asarray(value, dtype=float)
+            if not np.all(np.isfinite(array)):
+                raise ValueError(f"prescribed displacement must be finite; got {value!r}")
+            try:
+                np.broadcast_to(array.reshape(array.shape + (1,) * (array.ndim == 1)), self.dofs.shape)
+            except ValueError as err:
+                raise ValueError(
+                    f"prescribed value of shape {array.shape} does not fit {len(self.components)} components"
+                ) from err
+
+    def values(self, t: float) -> np.ndarray:
+        """Prescribed values at load factor ``t``, shape (ncomp, n)."""
+        if callable(self.value):
+            full = np.asarray(self.value(self.coordinates, t), dtype=float)
+            full = np.broadcast_to(full if full.ndim == 2 else full.reshape(-1, 1), (self.dim, self.dofs.shape[1]))
+            out = full[self.components]
+        else:
+            array = np.asarray(self.value, dtype=float)
+            array = array.reshape(array.shape + (1,) * (array.ndim == 1))
+            out = np.broadcast_to(array * (t if self.ramp else 1.0), self.dofs.shape)
+        if not np.all(np.isfinite(out)):
+            raise ValueError(f"prescribed displacement is not finite at load factor {t}")
+        return out
+
+
+class NodalForce:
+    """A force vector applied at each selected node (scalar dof)."""
+
+    def __init__(self, space: Space, scalar_dofs: np.ndarray, force, ramp: bool) -> None:
+        self.dofs = space.displacement_dofs(scalar_dofs)
+        self.force = load_function(force, ramp, "nodal force")
+        self.dim = space.dim
+
+    def vector(self, n_dofs: int, t: float) -> np.ndarray:
+        f = np.zeros(n_dofs)
+        value = np.asarray(self.force(t), dtype=float).reshape(self.dim, -1)
+        np.add.at(f, self.dofs, np.broadcast_to(value, self.dofs.shape))
+        return f
+
+
+class FollowerPressure:
+    """Pressure on reference facets that follows the deformed surface (positive pushes inward)."""
+
+    def __init__(self, space: Space, facets: np.ndarray, pressure, ramp: bool = True) -> None:
+        if facets.size == 0:
+            raise ValueError("pressure load on an empty facet set")
+        self.pressure = load_function(pressure, ramp, "pressure")
+        self.dim = space.dim
+        basis = fem.FacetBasis(space.mesh, space.element_u, facets=facets, intorder=space.intorder)
+        nb = basis.Nbfun
+        self.dN = np.ascontiguousarray(np.stack([basis.basis[a][0].grad for a in range(nb)]).transpose(2, 3, 0, 1))
+        self.N = np.stack([np.asarray(basis.basis[a][0]) for a in range(nb)]).transpose(1, 2, 0)  # (nf, nqp, nb)
+        normals = np.zeros((3,) + basis.normals.shape[1:])
+        normals[: self.dim] = basis.normals
+        self.normals = normals  # (3, nf, nqp)
+        self.dx = basis.dx
+        scalar = basis.element_dofs.T
+        self.element_dofs = (self.dim * scalar[:, :, None] + np.arange(self.dim)).reshape(scalar.shape[0], -1)
+
+    def assemble(self, u: np.ndarray, t: float, tangent: bool):
+        """Residual contributions (nf, nb*d) and load stiffness (nf, nb*d, nb*d) or None."""
+        p = float(self.pressure(t))
+        d = self.dim
+        nf, nqp, nb = self.N.shape
+        u_elem = u[self.element_dofs].reshape(nf, nb, d)
+        F = embed_3d(element_gradients(u_elem, self.dN))  # (3, 3, nqp, nf)
+        F = F.transpose(0, 1, 3, 2)  # (3, 3, nf, nqp)
+        # cof_iJ = 1/2 eps_ikm eps_JLM F_kL F_mM
+        cofF = 0.5 * np.einsum("ikm,JLM,kLfq,mMfq->iJfq", _LEVI_CIVITA, _LEVI_CIVITA, F, F, optimize=True)
+        weight = p * self.dx  # (nf, nqp)
+        traction = np.einsum("iJfq,Jfq->fqi", cofF, self.normals)[:, :, :d]
+        forces = np.einsum("fq,fqa,fqi->fai", weight, self.N, traction).reshape(nf, nb * d)
+        if not tangent:
+            return forces, None
+        D = np.einsum("ikm,JLM,mMfq,Jfq->fqikL", _LEVI_CIVITA, _LEVI_CIVITA, F, self.normals, optimize=True)
+        D = D[:, :, :d, :d, :d]
+        ke = np.einsum("fq,fqa,fqikL,fqbL->faibk", weight, self.N, D, self.dN, optimize=True)
+        ke = ke.reshape(nf, nb * d, nb * d)
+        return forces, ke
