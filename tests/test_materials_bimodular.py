@@ -88,3 +88,38 @@ def test_direction_batch_mismatch_raises():
     law = BimodularNeoHookean(MU_T, MU_C, np.ones((3, 4)))
     with pytest.raises(ValueError, match="direction batch shape"):
         law.pk1(random_deformations(5, seed=1))
+
+
+# ---------------------------------------------------------------- smoothed switch
+SMOOTH = BimodularNeoHookean(139.5, 29.55, direction=(1.0, 2.0, 0.5), smoothing=1e-2)
+
+
+def test_smoothed_tangent_and_stress_match_finite_differences_across_the_switch():
+    """Stretches straddling λ_a = 1 within the smoothing width, off-axis direction."""
+    rng = np.random.default_rng(7)
+    F = np.eye(3)[:, :, None] + 4e-3 * rng.standard_normal((3, 3, 12))
+    P, A = SMOOTH.pk1_and_tangent(F)
+    assert relative_error(A, fd_tangent(SMOOTH, F)) < 1e-6
+    h = 1e-7
+    dpsi = np.empty_like(P)
+    for k in range(3):
+        for L in range(3):
+            dF = np.zeros_like(F)
+            dF[k, L] = h
+            dpsi[k, L] = (SMOOTH.psi(F + dF) - SMOOTH.psi(F - dF)) / (2 * h)
+    assert relative_error(P, dpsi) < 1e-6
+
+
+@pytest.mark.parametrize("lam", [0.9, 1.1])
+def test_smoothed_law_equals_published_law_away_from_the_switch(lam):
+    """Outside the tanh layer (|I4 - 1| >> δ) the two laws coincide to tanh's tail, e^{-2|I4-1|/δ}."""
+    sharp = BimodularNeoHookean(139.5, 29.55, direction=(1.0, 0.0, 0.0))
+    smooth = BimodularNeoHookean(139.5, 29.55, direction=(1.0, 0.0, 0.0), smoothing=1e-2)
+    F = np.diag([lam, lam**-0.5, lam**-0.5])
+    tail = 2.0 * np.exp(-2.0 * abs(lam**2 - 1.0) / 1e-2)
+    assert relative_error(smooth.cauchy(F), sharp.cauchy(F)) < 1e-6 + tail
+
+
+def test_negative_smoothing_is_rejected():
+    with pytest.raises(ValueError, match="smoothing"):
+        BimodularNeoHookean(1.0, 1.0, (1.0, 0.0, 0.0), smoothing=-1.0)
