@@ -40,7 +40,9 @@ def test_reproduce_exit_code_follows_the_rows(monkeypatch, tmp_path, capsys):
     assert calls == [(tmp_path, True)]
     assert "skvalve reproduce mathur2022" in capsys.readouterr().out
     _fake_paper(monkeypatch, [Row("a", 1.0, 1.0, 0.1), Row("b", 2.0, 3.0, 0.1)])
-    assert main(["reproduce", "mathur2022", "--out", str(tmp_path)]) == 1
+    assert main(["reproduce", "mathur2022", "--out", str(tmp_path)]) == 0
+    assert "1 of 2 quantities within tolerance" in capsys.readouterr().out
+    assert main(["reproduce", "mathur2022", "--out", str(tmp_path), "--strict"]) == 1
 
 
 def test_reproduce_of_a_paper_without_module_says_so(monkeypatch, capsys):
