@@ -57,6 +57,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from numba import njit, prange
 
+from ..kinematics import cofactor, determinant
 from ..materials.base import Hyperelastic, VolumetricEnergy
 from ..materials.neo_hookean import NeoHookean
 
@@ -95,16 +96,6 @@ def neo_hookean_response(F: np.ndarray, mu: float, lmbda: float, tangent: bool):
                                     val += mu
                                 A[e, q, i, j, kk, L] = val
     return P, A
-
-
-def _cofactor(F: np.ndarray) -> np.ndarray:
-    cof = np.empty_like(F)
-    for i in range(3):
-        i1, i2 = (i + 1) % 3, (i + 2) % 3
-        for j in range(3):
-            j1, j2 = (j + 1) % 3, (j + 2) % 3
-            cof[i, j] = F[i1, j1] * F[i2, j2] - F[i1, j2] * F[i2, j1]
-    return cof
 
 
 def invert_volumetric(U: VolumetricEnergy, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -219,9 +210,8 @@ class MaterialRegions:
         if p is None:
             return P, A, None
         # mixed terms: -p cof F in P, -p dcof/dF in A
-        J = F[0, 0] * (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1]) - F[0, 1] * (F[1, 0] * F[2, 2] - F[1, 2] * F[2, 0]) \
-            + F[0, 2] * (F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0])
-        cof = _cofactor(F)
+        J = determinant(F)
+        cof = cofactor(F)
         P = P - p * cof
         if tangent:
             cofe = cof.transpose(3, 2, 0, 1)  # (nel, nqp, 3, 3)
