@@ -284,7 +284,7 @@ def write_figures(out: Path, studies: dict | None = None) -> list[Path]:
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
-    from .buchanan2014_fe import figure_7
+    from .buchanan2014_fe import figure_7, figure_11
     from .buchanan2014_sliding import figure_4_9_end_loading
 
     out.mkdir(parents=True, exist_ok=True)
@@ -294,6 +294,8 @@ def write_figures(out: Path, studies: dict | None = None) -> list[Path]:
     studies = studies or {}
     if studies.get("warping") is not None:
         figures.append(("fig7_edge_centre_warping", lambda: figure_7(studies["warping"])))
+    if studies.get("warping_thickness") is not None:
+        figures.append(("fig11_warping_vs_thickness", lambda: figure_11(studies["warping_thickness"])))
     if studies.get("sliding") is not None:
         figures.append(("fig4_9_end_loading_sliding", lambda: figure_4_9_end_loading(studies["sliding"])))
     for name, draw in figures:

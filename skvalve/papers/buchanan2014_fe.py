@@ -26,7 +26,7 @@ from .buchanan2014 import (
 from .table import Row
 
 __all__ = [
-    "strip_mesh", "fe_pure_bending", "warping_study", "warping_versus_thickness", "fe_rows", "figure_7",
+    "strip_mesh", "fe_pure_bending", "warping_study", "warping_versus_thickness", "fe_rows", "figure_7", "figure_11",
 ]
 
 
@@ -164,9 +164,8 @@ def warping_versus_thickness(thicknesses=FIG11_THICKNESSES, curvatures=CURVATURE
     return out
 
 
-def _warping_thickness_rows() -> list[Row]:
+def _warping_thickness_rows(table: np.ndarray) -> list[Row]:
     """Fig. 11 trends (paper: warping grows with thickness and with curvature) as pass/fail rows."""
-    table = warping_versus_thickness()
     grows_with_h = float(np.all(np.diff(table, axis=0) > 0))
     grows_with_k = float(np.all(np.diff(table, axis=1) > 0))
     pairs = zip(FIG11_THICKNESSES, table, strict=True)
@@ -213,12 +212,25 @@ def fe_rows(full: bool = False) -> tuple[list[Row], dict]:
                               f"{w['neutral_axis'] / warp['H']:.3f}, edge {w['neutral_axis_edge'] / warp['H']:.3f}, "
                               f"plane strain {ref.normalised_neutral_axis:.3f}; 3D/plane-strain moment "
                               f"{w['moment'] / ref.moment:.3f}")))
-    if full:
-        rows.extend(_warping_thickness_rows())
+    thickness_table = warping_versus_thickness() if full else None
+    if thickness_table is not None:
+        rows.extend(_warping_thickness_rows(thickness_table))
     from .buchanan2014_sliding import sliding_rows  # it imports strip_mesh from here
 
     sliding, study = sliding_rows(full)
-    return rows + sliding, {"warping": warp, "sliding": study}
+    return rows + sliding, {"warping": warp, "sliding": study, "warping_thickness": thickness_table}
+
+
+def figure_11(table: np.ndarray, ax=None):
+    """Fig. 11: edge–centre warping max |ΔΛ1| versus strip thickness, one line per curvature."""
+    import matplotlib.pyplot as plt
+
+    ax = ax if ax is not None else plt.subplots(figsize=(5, 4))[1]
+    for j, curvature in enumerate(CURVATURES):
+        ax.plot(FIG11_THICKNESSES, table[:, j], "o-", label=f"Δκ = {curvature} mm⁻¹")
+    ax.set(xlabel="thickness H (mm)", ylabel="max |Λ1 edge − Λ1 centre|", title="3D strip warping (Fig. 11)")
+    ax.legend()
+    return ax
 
 
 def figure_7(warp: dict, axes=None):
