@@ -11,14 +11,21 @@ from skvalve.fem.meshes import annulus_sector, box, distort, rectangle
 from skvalve.materials import IncompressibleNeoHookean, NeoHookean, Ogden
 
 
+def _random_state_and_direction(solid: Solid, scale: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """A random displacement u (size ``scale``) and direction v, both zero on constrained dofs."""
+    rng = np.random.default_rng(seed)
+    free = solid.pattern["free"]
+    u = np.zeros(solid.space.n_dofs)
+    u[free] = scale * rng.standard_normal(free.size)
+    v = np.zeros_like(u)
+    v[free] = rng.standard_normal(free.size)
+    return u, v
+
+
 def _full_tangent_check(solid: Solid, scale: float = 0.05, seed: int = 1) -> float:
     """max |K v - (R(u+hv) - R(u-hv)) / 2h| / max |K v| on the free dofs at a random state."""
-    rng = np.random.default_rng(seed)
     pat = solid.pattern
-    u = np.zeros(solid.space.n_dofs)
-    u[pat["free"]] = scale * rng.standard_normal(pat["free"].size)
-    v = np.zeros_like(u)
-    v[pat["free"]] = rng.standard_normal(pat["free"].size)
+    u, v = _random_state_and_direction(solid, scale, seed)
     residual, matrices = solid.assemble(u, 0.7)
     K = solid.tangent_matrix(matrices)
     h = 1e-6
@@ -51,12 +58,7 @@ def test_domain_tangent_matches_finite_differences(name):
 
 def _pressure_part_check(solid: Solid, scale: float, seed: int = 2) -> float:
     """Same check restricted to the follower-pressure terms: (K_p v - FD of R_p) / |K_p v|."""
-    rng = np.random.default_rng(seed)
-    pat = solid.pattern
-    u = np.zeros(solid.space.n_dofs)
-    u[pat["free"]] = scale * rng.standard_normal(pat["free"].size)
-    v = np.zeros_like(u)
-    v[pat["free"]] = rng.standard_normal(pat["free"].size)
+    u, v = _random_state_and_direction(solid, scale, seed)
 
     def pressure_residual(state):
         return sum(np.bincount(load.element_dofs.ravel(), load.assemble(state, 0.7, False)[0].ravel(),
