@@ -32,6 +32,7 @@ import numpy as np
 import scipy.sparse as sp
 import skfem as fem
 
+from ..kinematics import determinant
 from ..materials.base import Hyperelastic
 from .constitutive import MaterialRegions
 from .kernels import csr_pattern, element_forces, element_gradients, element_stiffness, scatter_add
@@ -165,9 +166,7 @@ class Solid:
         return embed_3d(element_gradients(u_elem, sp_.dN))
 
     def _check_jacobian(self, F: np.ndarray, step, t) -> None:
-        J = F[0, 0] * (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1]) - F[0, 1] * (F[1, 0] * F[2, 2] - F[1, 2] * F[2, 0]) \
-            + F[0, 2] * (F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0])
-        bad = ~(J > 0.0)
+        bad = ~(determinant(F) > 0.0)
         if np.any(bad):
             raise NonPositiveJacobianError(np.flatnonzero(bad.any(axis=0)), step, t)
 

@@ -50,7 +50,7 @@ from numpy.typing import ArrayLike
 from ..kinematics import Array
 from .base import check_nonnegative, check_positive
 from .incompressible_neo_hookean import IncompressibleNeoHookean
-from .isotropic import IsotropicInvariantLaw, Partials
+from .isotropic import IsotropicInvariantLaw, Partials, outer
 
 __all__ = ["BimodularNeoHookean", "normalised_direction"]
 
@@ -141,7 +141,6 @@ class BimodularNeoHookean(IsotropicInvariantLaw):
         S1, CC1 = _UNIT.response_C(C)
         psi1 = _UNIT.energy_C(C)
         A = self._structure_tensor(C)
-        outer = lambda X, Y: np.einsum("IJ...,KL...->IJKL...", X, Y)
         S = mu * S1 + 2.0 * d_mu * psi1 * A
         CC = mu * CC1 + 2.0 * d_mu * (outer(S1, A) + outer(A, S1)) + 4.0 * dd_mu * psi1 * outer(A, A)
         return S, CC
