@@ -1,0 +1,98 @@
+"""Read Abaqus input files (``.inp``) into an assembled :class:`AbaqusModel`.
+
+Written for the Texas TriValve models (Mathur et al. 2022, Engineering with Computers,
+doi:10.1007/s00366-022-01659-w; 1.0 files CC BY-NC-SA 4.0, 1.1 files CC BY 4.0) but general: parts,
+instances (translation and rotation), all ``*Node`` blocks, element blocks, node/element sets (with
+``generate``), element-face surfaces, sections, materials, amplitudes, boundary conditions, ``*Dsload``,
+contact pairs and general contact, ``*MPC``, rigid bodies, connectors, transforms and steps.
+
+Modules: :mod:`.lexer` (cards, strict numbers, ``*Include``), :mod:`.model` (the dataclasses),
+:mod:`.materials`, :mod:`.mesh` and :mod:`.mesh_cards` (mesh keywords), :mod:`.step_cards` (history and
+constraint keywords), :mod:`.reader` (dispatch and assembly).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from .elements import HEX_FACE_NODES, NODES_PER_ELEMENT
+from .errors import AbaqusParseError, Location
+from .materials import AbaqusMaterial, MaterialOption
+from .model import (
+    MPC,
+    AbaqusModel,
+    Amplitude,
+    BoundaryCondition,
+    ConcentratedLoad,
+    ConnectorSection,
+    ContactPair,
+    DistributedLoad,
+    ElementBlock,
+    ElementSet,
+    GeneralContact,
+    IgnoredKeyword,
+    Instance,
+    NodeSet,
+    ReadWarning,
+    RigidBody,
+    Section,
+    Step,
+    Surface,
+    SurfaceFaces,
+    SurfaceInteraction,
+    Transform,
+)
+from .reader import IGNORED_KEYWORDS, read_model
+
+__all__ = [
+    "read_model", "read_materials", "trivalve_input", "trivalve_inputs", "AbaqusParseError", "Location",
+    "AbaqusModel", "AbaqusMaterial", "MaterialOption", "ElementBlock", "NodeSet", "ElementSet", "Surface",
+    "SurfaceFaces", "Section", "Instance", "Amplitude", "BoundaryCondition", "DistributedLoad", "ConcentratedLoad",
+    "ContactPair", "GeneralContact", "SurfaceInteraction", "MPC", "RigidBody", "ConnectorSection", "Transform",
+    "Step", "IgnoredKeyword", "ReadWarning", "IGNORED_KEYWORDS", "HEX_FACE_NODES", "NODES_PER_ELEMENT",
+]
+
+#: Where the shared Texas TriValve data are looked for, relative to the repository root.
+DATA_RELATIVE = Path("..") / "shared" / "data"
+TRIVALVE_RELATIVE = DATA_RELATIVE / "texas_trivalve" / "Diseased_QuasiStatic.inp"
+#: The five shipped inputs, by short key, relative to the data folder.
+TRIVALVE_FILES = {
+    "1.0-diseased": Path("texas_trivalve") / "Diseased_QuasiStatic.inp",
+    "1.0-annuloplasty": Path("texas_trivalve") / "Annuloplasty_QuasiStatic.inp",
+    "1.0-clipping": Path("texas_trivalve") / "Clipping_QuasiStatic.inp",
+    "1.1-healthy": Path("texas_trivalve_1.1") / "Healthy" / "Healthy_QuasiStatic.inp",
+    "1.1-diseased": Path("texas_trivalve_1.1") / "Diseased" / "Diseased_QuasiStatic.inp",
+}
+
+
+def read_materials(path: str | os.PathLike) -> dict[str, AbaqusMaterial]:
+    """All ``*Material`` blocks of an Abaqus input file, by name as written (the whole file is checked)."""
+    return read_model(path).materials
+
+
+def _data_folder() -> Path | None:
+    here = Path(__file__).resolve().parents[3]
+    for candidate in (here / DATA_RELATIVE, Path.cwd() / DATA_RELATIVE):
+        if candidate.is_dir():
+            return candidate
+    return None
+
+
+def trivalve_input() -> Path | None:
+    """The Texas TriValve 1.0 diseased input if present: ``$SKVALVE_TRIVALVE`` or ``../shared/data/...``."""
+    env = os.environ.get("SKVALVE_TRIVALVE")
+    if env and Path(env).is_file():
+        return Path(env)
+    folder = _data_folder()
+    if folder is not None and (folder / TRIVALVE_FILES["1.0-diseased"]).is_file():
+        return folder / TRIVALVE_FILES["1.0-diseased"]
+    return None
+
+
+def trivalve_inputs() -> dict[str, Path]:
+    """Those of the five shipped Texas TriValve inputs that are present, by key (``"1.1-healthy"``, ...)."""
+    folder = _data_folder()
+    if folder is None:
+        return {}
+    return {key: folder / rel for key, rel in TRIVALVE_FILES.items() if (folder / rel).is_file()}
