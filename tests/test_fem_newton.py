@@ -8,6 +8,7 @@ from scipy.optimize import brentq
 from skvalve.analytic import homogeneous
 from skvalve.fem import ConvergenceError, NonPositiveJacobianError, Solid
 from skvalve.fem.meshes import box, rectangle
+from skvalve.io.timeseries import TimeSeriesWriter
 from skvalve.materials import BimodularNeoHookean, IncompressibleNeoHookean, NeoHookean
 
 MATERIAL = NeoHookean.from_shear_poisson(1.0, 0.3)
@@ -51,7 +52,8 @@ def test_inverted_element_raises_with_elements_and_step():
 def test_nonconvergence_carries_last_converged_state_on_disk(tmp_path):
     solid = _uniaxial_block(2.5, n=2)
     with pytest.raises(ConvergenceError, match="cut-backs") as info:
-        solid.solve(steps=[0.02, 1.0], max_iter=3, max_cutbacks=0, progress=False, output=tmp_path / "run.pvd")
+        solid.solve(steps=[0.02, 1.0], max_iter=3, max_cutbacks=0, progress=False,
+                    callbacks=[TimeSeriesWriter(tmp_path / "run.pvd", solid)])
     last = info.value.last_converged
     assert last.load_factors == [0.0, 0.02]
     written = sorted(tmp_path.glob("run_*.vtu"))

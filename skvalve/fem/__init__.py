@@ -1,4 +1,4 @@
-"""Finite-strain solid mechanics on scikit-fem: total-Lagrangian, displacement or mixed u/p.
+"""Finite-strain solid mechanics on scikit-fem: a displacement field and a sum of terms.
 
 Typical use::
 
@@ -8,17 +8,34 @@ Typical use::
     result = solid.solve(steps=5)
     result.reaction("right"), result.evaluate("cauchy")
 
-See ``docs/fem.md``. Derivations are in the module docstrings: :mod:`.solid` (weak form),
+:class:`Solid` is a :class:`Problem` with a :class:`HyperelasticTerm`; any other term (trusses,
+contact, constraints) joins with :meth:`Problem.add_term`, and :func:`solve` is the Newton driver.
+See ``docs/fem.md``. Derivations are in the module docstrings: :mod:`.hyperelastic` (weak form),
 :mod:`.constitutive` (mixed u/p), :mod:`.loads` (follower pressure), :mod:`.newton`.
 """
 
+from .constitutive import MaterialRegions
+from .errors import (
+    ConvergenceError,
+    NonPositiveJacobianError,
+    OutputError,
+    SingularSystemError,
+    SolverError,
+    TangledMeshError,
+)
+from .hyperelastic import HyperelasticTerm
 from .linsolve import available_solvers, solver_name
-from .newton import solve
+from .loads import FollowerPressure, NodalForce
+from .newton import StepEvent, solve
+from .problem import Problem
 from .result import Result
-from .solid import ConvergenceError, NonPositiveJacobianError, Solid, SolverError
+from .solid import Solid
 from .space import Space
+from .terms import Blocks, Contribution, Term
 
 __all__ = [
-    "Solid", "Result", "Space", "solve", "SolverError", "ConvergenceError", "NonPositiveJacobianError",
-    "solver_name", "available_solvers",
+    "Solid", "Problem", "Term", "Blocks", "Contribution", "HyperelasticTerm", "MaterialRegions", "FollowerPressure",
+    "NodalForce", "Result", "Space", "solve", "StepEvent", "SolverError", "ConvergenceError",
+    "NonPositiveJacobianError", "SingularSystemError", "OutputError", "TangledMeshError", "solver_name",
+    "available_solvers",
 ]

@@ -115,18 +115,28 @@ def invert_volumetric(U: VolumetricEnergy, p: np.ndarray) -> tuple[np.ndarray, n
     return Jbar, 1.0 / h
 
 
+def _is_quadrature_material(material) -> bool:
+    """Duck-typed material evaluated in batch at the quadrature points (e.g. an FE² RVE material)."""
+    return all(hasattr(material, name) for name in ("pk1", "pk1_and_tangent", "cauchy", "incompressible"))
+
+
 class Region:
     """One material on a set of elements (``elements`` is ``slice(None)`` for all)."""
 
     def __init__(self, material: Hyperelastic, elements, mixed: bool) -> None:
-        if not isinstance(material, Hyperelastic):
-            raise TypeError(f"material must be a skvalve.materials.Hyperelastic; got {type(material).__name__}")
+        if not isinstance(material, Hyperelastic) and not _is_quadrature_material(material):
+            raise TypeError(
+                "material must be a skvalve.materials.Hyperelastic or a quadrature-point material with "
+                f"pk1, pk1_and_tangent, cauchy and incompressible; got {type(material).__name__}"
+            )
         self.material = material
         self.elements = elements
         self.volumetric: VolumetricEnergy | None = None
         self.law = material
         if mixed:
             if not material.incompressible:
+                if not hasattr(material, "split"):
+                    raise ValueError(f"{type(material).__name__} has no split(): use the displacement formulation")
                 rest, U = material.split()
                 if U is None:
                     raise ValueError(
@@ -158,7 +168,7 @@ class MaterialRegions:
     def __init__(self, mesh, materials, regions=None, mixed: bool = False) -> None:
         nel = mesh.nelements
         self.nel = nel
-        if isinstance(materials, Hyperelastic):
+        if isinstance(materials, Hyperelastic) or _is_quadrature_material(materials):
             if regions is not None:
                 raise ValueError("regions is only used with a sequence of materials")
             self.regions = [Region(materials, slice(None), mixed)]

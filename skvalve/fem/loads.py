@@ -28,6 +28,7 @@ import skfem as fem
 
 from .kernels import element_gradients
 from .space import Space
+from .terms import Blocks, Contribution, Term
 
 __all__ = ["Dirichlet", "FollowerPressure", "NodalForce", "load_function", "embed_3d"]
 
@@ -91,13 +92,20 @@ class Dirichlet:
         return out
 
 
-class NodalForce:
-    """A force vector applied at each selected node (scalar dof)."""
+class NodalForce(Term):
+    """A force vector applied at each selected node (scalar dof): an external, dead load."""
+
+    load_dependent = True
+    name = "nodal force"
 
     def __init__(self, space: Space, scalar_dofs: np.ndarray, force, ramp: bool) -> None:
         self.dofs = space.displacement_dofs(scalar_dofs)
         self.force = load_function(force, ramp, "nodal force")
         self.dim = space.dim
+        self.n_dofs = space.n_dofs
+
+    def assemble(self, u: np.ndarray, t: float, tangent: bool, step: int | None) -> Contribution:
+        return Contribution(external=self.vector(self.n_dofs, t))
 
     def vector(self, n_dofs: int, t: float) -> np.ndarray:
         f = np.zeros(n_dofs)
@@ -106,12 +114,23 @@ class NodalForce:
         return f
 
 
-class FollowerPressure:
+class FollowerPressure(Term):
     """Pressure on reference facets that follows the deformed surface (positive pushes inward)."""
+
+    load_dependent = True
+    symmetric = False
+    name = "follower pressure"
 
     def __init__(self, space: Space, facets: np.ndarray, pressure, ramp: bool = True) -> None:
         if facets.size == 0:
             raise ValueError("pressure load on an empty facet set")
+        interior = np.setdiff1d(facets, space.mesh.boundary_facets())
+        if interior.size:
+            raise ValueError(
+                f"pressure on {interior.size} interior facet(s) [{', '.join(map(str, interior[:10]))}]: "
+                "a follower pressure acts on boundary facets only"
+            )
+        self.n_dofs = space.n_dofs
         self.pressure = load_function(pressure, ramp, "pressure")
         self.dim = space.dim
         basis = fem.FacetBasis(space.mesh, space.element_u, facets=facets, intorder=space.intorder)
@@ -125,7 +144,16 @@ class FollowerPressure:
         scalar = basis.element_dofs.T
         self.element_dofs = (self.dim * scalar[:, :, None] + np.arange(self.dim)).reshape(scalar.shape[0], -1)
 
-    def assemble(self, u: np.ndarray, t: float, tangent: bool):
+    def connectivity(self) -> list[np.ndarray]:
+        return [self.element_dofs]
+
+    def assemble(self, u: np.ndarray, t: float, tangent: bool, step: int | None = None) -> Contribution:
+        """External forces (a follower pressure does work against the normal) and the load stiffness."""
+        forces, ke = self.element_terms(u, t, tangent)
+        external = -np.bincount(self.element_dofs.ravel(), forces.ravel(), minlength=self.n_dofs)
+        return Contribution(external=external, blocks=[Blocks(self.element_dofs, ke)])
+
+    def element_terms(self, u: np.ndarray, t: float, tangent: bool):
         """Residual contributions (nf, nb*d) and load stiffness (nf, nb*d, nb*d) or None."""
         p = float(self.pressure(t))
         d = self.dim

@@ -9,8 +9,8 @@ state and the increment :math:`\Delta u_D` of the prescribed displacements it so
     K_{ff}\,\Delta u_f = -R_f(u_n, t_{n+1}) - K_{fD}\,\Delta u_D ,
 
 then iterates :math:`K_{ff}(u^k)\,\Delta u_f = -R_f(u^k, t_{n+1})`. The tangent at :math:`u_n`
-is the one assembled at the last accepted iterate of the previous step (loads re-evaluated). A step
-:math:`u^{k+1} = u^k + \alpha\,\Delta u` is accepted for the largest
+is the one assembled at the last accepted iterate of the previous step (load-dependent terms
+re-evaluated). A step :math:`u^{k+1} = u^k + \alpha\,\Delta u` is accepted for the largest
 :math:`\alpha \in \{1, \tfrac12, \dots\}` that keeps :math:`J > 0` and does not increase
 :math:`\lVert R_f\rVert` (backtracking line search). Convergence: relative residual
 
@@ -21,110 +21,171 @@ is the one assembled at the last accepted iterate of the previous step (loads re
     \frac{|\Delta u^k\cdot R^{k-1}|}{|\Delta u^1\cdot R^0|} \le \text{energy\_tol},
 
 with :math:`R_D` the reactions. A step that fails (too many iterations, :math:`J \le 0`,
-singular tangent) is retried with half the increment, up to ``max_cutbacks`` times; the
-increment grows back after successes. Converged steps are stored in a :class:`Result`.
+singular tangent) is retried with half the increment, up to ``max_cutbacks`` times, after
+:meth:`~skvalve.fem.problem.Problem.rewind`; a converged step is
+:meth:`~skvalve.fem.problem.Problem.commit`-ted, stored in a :class:`Result` and handed to the
+callbacks (output, checkpoints). A tangent that is singular at the unloaded state (a body without
+enough supports) raises :class:`SingularSystemError` at once.
 """
 
 from __future__ import annotations
 
 import logging
+import math
 import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 from tqdm.auto import tqdm
 
 from . import linsolve
+from .errors import ConvergenceError, NonPositiveJacobianError, OutputError, SingularSystemError, SolverError
+from .problem import Problem
 from .result import Result
-from .solid import ConvergenceError, NonPositiveJacobianError, Solid, SolverError
 
-__all__ = ["solve"]
+__all__ = ["solve", "StepEvent", "NewtonOptions"]
 
 logger = logging.getLogger("skvalve.fem")
+
+#: linear solves whose relative residual exceeds this are taken as singular
+_LINEAR_RESIDUAL_LIMIT = 1e-6
 
 
 class _StepFailed(Exception):
     pass
 
 
-def _load_factors(steps) -> np.ndarray:
+@dataclass
+class NewtonOptions:
+    """Validated options of :func:`solve`."""
+
+    rtol: float = 1e-8
+    energy_tol: float | None = None
+    max_iter: int = 25
+    max_cutbacks: int = 6
+    line_search: bool = True
+    max_line_search: int = 4
+    solver: str = "scipy"
+    verbose: bool = False
+    timings: dict = field(default_factory=lambda: {"setup": 0.0, "assembly": 0.0, "solve": 0.0})
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.rtol, int | float) and math.isfinite(self.rtol) and self.rtol > 0):
+            raise ValueError(f"rtol must be a positive finite number; got {self.rtol!r}")
+        if self.energy_tol is not None and not (
+            isinstance(self.energy_tol, int | float) and math.isfinite(self.energy_tol) and self.energy_tol > 0
+        ):
+            raise ValueError(f"energy_tol must be None or a positive finite number; got {self.energy_tol!r}")
+        for name, low in (("max_iter", 1), ("max_cutbacks", 0), ("max_line_search", 0)):
+            value = getattr(self, name)
+            if not isinstance(value, int | np.integer) or isinstance(value, bool) or value < low:
+                raise ValueError(f"{name} must be an integer >= {low}; got {value!r}")
+
+
+@dataclass
+class StepEvent:
+    """What a callback receives after each converged step (step 0 is the initial state)."""
+
+    problem: Problem
+    step: int
+    load_factor: float
+    u: np.ndarray
+    result: Result
+
+
+def _load_factors(steps, t0: float) -> np.ndarray:
     if np.isscalar(steps):
-        if int(steps) != steps or steps < 1:
+        if isinstance(steps, bool) or int(steps) != steps or steps < 1:
             raise ValueError(f"steps must be a positive integer or an increasing sequence; got {steps!r}")
-        return np.linspace(0.0, 1.0, int(steps) + 1)[1:]
-    factors = np.asarray(steps, dtype=float).ravel()
-    if factors.size == 0 or np.any(np.diff(factors) <= 0) or factors[0] <= 0 or not np.all(np.isfinite(factors)):
-        raise ValueError("load factors must be positive, finite and strictly increasing")
-    return factors
+        factors = np.linspace(0.0, 1.0, int(steps) + 1)[1:]
+    else:
+        factors = np.asarray(steps, dtype=float).ravel()
+        if factors.size == 0 or np.any(np.diff(factors) <= 0) or factors[0] <= 0 or not np.all(np.isfinite(factors)):
+            raise ValueError("load factors must be positive, finite and strictly increasing")
+    return factors[factors > t0 * (1 + 1e-12)]
 
 
-def _reference(solid: Solid, residual: np.ndarray, fixed: np.ndarray) -> float:
-    return max(np.linalg.norm(residual[fixed]), np.linalg.norm(solid.external_forces), 1e-300)
+def _reference(problem: Problem, residual: np.ndarray, fixed: np.ndarray) -> float:
+    return max(np.linalg.norm(residual[fixed]), np.linalg.norm(problem.external_forces), 1e-300)
 
 
-def _newton_step(solid: Solid, u_old: np.ndarray, t_old: float, t_new: float, step: int, opts: dict,
-                 cached=None):
-    pat = solid.pattern
-    fixed, free = pat["fixed"], pat["free"]
-    _, old_values = solid.constrained(t_old)
-    _, new_values = solid.constrained(t_new)
-    timings = opts["timings"]
+def _linear_solve(problem: Problem, K, rhs: np.ndarray, opts: NewtonOptions) -> np.ndarray:
+    start = time.perf_counter()
+    try:
+        x = linsolve.solve(K, rhs, opts.solver, symmetric=problem.symmetric)
+    except np.linalg.LinAlgError as err:
+        raise SingularSystemError(f"singular tangent: {err}") from err
+    finally:
+        opts.timings["solve"] += time.perf_counter() - start
+    scale = np.linalg.norm(rhs)
+    if scale > 0 and np.linalg.norm(K @ x - rhs) > _LINEAR_RESIDUAL_LIMIT * scale:
+        raise SingularSystemError(
+            f"singular tangent: the linear solve leaves a relative residual "
+            f"{np.linalg.norm(K @ x - rhs) / scale:.1e} (|du| = {np.linalg.norm(x):.1e})"
+        )
+    return x
+
+
+def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int, opts: NewtonOptions, cached=None):
+    pat = problem.pattern
+    fixed, free = pat.fixed, pat.free
+    _, old_values = problem.constrained(t_old)
+    _, new_values = problem.constrained(t_new)
     u = u_old.copy()
     start = time.perf_counter()
-    # the tangent of the converged state (last accepted trial) is reused: only loads change with t
-    residual, mats = solid.assemble(u, t_new, tangent=True, step=step, reuse=cached)
-    timings["assembly"] += time.perf_counter() - start
+    # the tangent of the converged state (last accepted trial) is reused: only load terms change with t
+    residual, tangent = problem.assemble(u, t_new, tangent=True, step=step, reuse=cached)
+    opts.timings["assembly"] += time.perf_counter() - start
     rhs = residual
-    if fixed.size and np.any(new_values != old_values):
+    moved = fixed.size and np.any(new_values != old_values)
+    if moved:
         prescribed = np.zeros_like(u)
         prescribed[fixed] = new_values - old_values
-        rhs = residual + solid.apply_elements(mats, prescribed)
+        rhs = residual + problem.apply(tangent, prescribed)
         u[fixed] = new_values
-        moved = True
-    else:
-        moved = False
-    reference = _reference(solid, residual, fixed)
+    reference = _reference(problem, residual, fixed)
     norm = np.linalg.norm(rhs[free])
     history = []
-    if not moved and norm <= opts["rtol"] * reference:
-        return u, residual, history, (solid.internal_forces, mats)
-    energy0 = None
-    for iteration in range(1, opts["max_iter"] + 1):
+    if not moved and norm <= opts.rtol * reference:
+        return u, residual, history, tangent
+    energy0, last_error = None, None
+    for iteration in range(1, opts.max_iter + 1):
         start = time.perf_counter()
-        K = solid.tangent_matrix(mats)
-        timings["assembly"] += time.perf_counter() - start
-        start = time.perf_counter()
+        K = problem.tangent_matrix(tangent)
+        opts.timings["assembly"] += time.perf_counter() - start
         try:
-            du_free = linsolve.solve(K, -rhs[free], opts["solver"], symmetric=not solid.pressures)
-        except np.linalg.LinAlgError as err:
-            raise _StepFailed(f"linear solve failed: {err}") from err
-        finally:
-            timings["solve"] += time.perf_counter() - start
+            du_free = _linear_solve(problem, K, -rhs[free], opts)
+        except SingularSystemError as err:
+            failed = _StepFailed(str(err))
+            failed.iterations_done = iteration - 1
+            raise failed from err
         du = np.zeros_like(u)
         du[free] = du_free
         energy = abs(du_free @ rhs[free])
         energy0 = energy if energy0 is None else energy0
         alpha, accepted = 1.0, None
-        for _ in range(opts["max_line_search"] + 1):
+        for _ in range(opts.max_line_search + 1):
             trial = u + alpha * du
             start = time.perf_counter()
             try:
-                trial_residual, trial_mats = solid.assemble(trial, t_new, tangent=True, step=step)
+                trial_residual, trial_tangent = problem.assemble(trial, t_new, tangent=True, step=step)
             except NonPositiveJacobianError as err:
                 last_error = err
                 alpha *= 0.5
                 continue
             finally:
-                timings["assembly"] += time.perf_counter() - start
+                opts.timings["assembly"] += time.perf_counter() - start
             trial_norm = np.linalg.norm(trial_residual[free])
-            if not opts["line_search"] or trial_norm <= norm or alpha < 2.0 ** -opts["max_line_search"] * 1.5:
-                accepted = (trial, trial_residual, trial_mats, trial_norm)
+            if not opts.line_search or trial_norm <= norm or alpha < 2.0 ** -opts.max_line_search * 1.5:
+                accepted = (trial, trial_residual, trial_tangent, trial_norm)
                 break
             alpha *= 0.5
         if accepted is None:
             raise _StepFailed(str(last_error)) from last_error
-        u, residual, mats, norm = accepted
+        u, residual, tangent, norm = accepted
         rhs = residual
-        reference = _reference(solid, residual, fixed)
+        reference = _reference(problem, residual, fixed)
         relative = norm / reference
         relative_energy = energy / energy0 if energy0 > 0 else 0.0
         record = {"step": step, "load_factor": t_new, "iteration": iteration, "residual": norm,
@@ -133,49 +194,77 @@ def _newton_step(solid: Solid, u_old: np.ndarray, t_old: float, t_new: float, st
         history.append(record)
         logger.info("step %d t=%.4g it %d |R|=%.3e rel=%.3e |du|=%.3e energy=%.3e alpha=%.3g", step, t_new,
                     iteration, norm, relative, record["increment"], relative_energy, alpha)
-        if opts["verbose"]:
+        if opts.verbose:
             print(f"  step {step} t={t_new:.4g} iter {iteration}: |R|/ref={relative:.3e} "
                   f"|du|={record['increment']:.3e} energy={relative_energy:.3e} alpha={alpha:g}")
         if not np.isfinite(norm):
             raise _StepFailed("residual is not finite")
-        if relative <= opts["rtol"] and (opts["energy_tol"] is None or relative_energy <= opts["energy_tol"]):
-            return u, residual, history, (solid.internal_forces, mats)
-    raise _StepFailed(f"no convergence in {opts['max_iter']} iterations (relative residual {relative:.3e})")
+        if relative <= opts.rtol and (opts.energy_tol is None or relative_energy <= opts.energy_tol):
+            return u, residual, history, tangent
+    raise _StepFailed(f"no convergence in {opts.max_iter} iterations (relative residual {relative:.3e})")
 
 
-def solve(solid: Solid, steps=10, *, rtol: float = 1e-8, energy_tol: float | None = None, max_iter: int = 25,
+def _notify(callbacks, event: StepEvent) -> None:
+    for callback in callbacks:
+        try:
+            callback(event)
+        except Exception as err:  # noqa: BLE001 - any output failure keeps the converged steps
+            error = OutputError(f"step callback {callback!r} failed after load step {event.step} "
+                                f"(load factor {event.load_factor:.6g}): {type(err).__name__}: {err}")
+            error.last_converged = event.result
+            raise error from err
+
+
+def solve(problem: Problem, steps=10, *, rtol: float = 1e-8, energy_tol: float | None = None, max_iter: int = 25,
           max_cutbacks: int = 6, line_search: bool = True, max_line_search: int = 4, solver: str | None = None,
-          progress: bool = True, verbose: bool = False, output=None, u0: np.ndarray | None = None) -> Result:
+          progress: bool = True, verbose: bool = False, u0: np.ndarray | None = None, t0: float = 0.0,
+          callbacks: Sequence[Callable[[StepEvent], None]] = ()) -> Result:
     """Solve the load path ``t`` in ``steps`` (int: uniform steps to 1; or increasing factors).
 
-    Returns a :class:`Result` with the converged steps (and the reference state first).
-    ``output``: path of a ``.pvd`` ParaView time series written after each converged step.
-    Raises :class:`NonPositiveJacobianError` or :class:`ConvergenceError` (both carry
-    ``last_converged``) when a step fails after ``max_cutbacks`` halvings.
-    """
-    if rtol <= 0 or max_iter < 1 or max_cutbacks < 0:
-        raise ValueError("rtol must be positive, max_iter >= 1 and max_cutbacks >= 0")
-    factors = _load_factors(steps)
-    opts = {"rtol": rtol, "energy_tol": energy_tol, "max_iter": int(max_iter), "line_search": line_search,
-            "max_line_search": int(max_line_search), "solver": linsolve.solver_name(solver), "verbose": verbose}
-    start = time.perf_counter()
-    opts["timings"] = {"setup": 0.0, "assembly": 0.0, "solve": 0.0}
-    solid._build_pattern()
-    u = np.zeros(solid.space.n_dofs) if u0 is None else np.array(u0, dtype=float)
-    if u.shape != (solid.space.n_dofs,):
-        raise ValueError(f"u0 must have shape ({solid.space.n_dofs},)")
-    residual, _ = solid.assemble(u, 0.0, tangent=False, step=0)
-    writer = None
-    if output is not None:
-        from ..io.timeseries import TimeSeriesWriter
+    Parameters
+    ----------
+    problem : the :class:`~skvalve.fem.problem.Problem` (e.g. a :class:`~skvalve.fem.Solid`).
+    steps : number of uniform load steps to ``t = 1``, or the increasing load factors to reach.
+    rtol, energy_tol : convergence tolerances (relative residual; optional relative energy).
+    max_iter, max_cutbacks, line_search, max_line_search : Newton controls.
+    solver : sparse backend (``"pardiso"``, ``"umfpack"``, ``"scipy"``; default the fastest).
+    progress, verbose : a progress bar over load steps; a line per iteration.
+    u0, t0 : start from state ``u0`` at load factor ``t0`` (resume); factors <= ``t0`` are skipped.
+    callbacks : called with a :class:`StepEvent` after the initial state and each converged step
+        (e.g. :class:`skvalve.io.timeseries.TimeSeriesWriter`); a callback that raises ends the
+        solve with :class:`OutputError` carrying the converged steps.
 
-        writer = TimeSeriesWriter(output, solid)
-    result = Result(solid, solver=opts["solver"], writer=writer)
-    result.timings = opts["timings"]
-    result.timings["setup"] = time.perf_counter() - start
-    result.append(0.0, u, residual, [])
-    t, target_index = 0.0, 0
-    increment, failures = _nominal(factors, 0), 0
+    Returns
+    -------
+    Result
+        The converged steps (the start state first).
+
+    Raises
+    ------
+    NonPositiveJacobianError, ConvergenceError, SingularSystemError
+        When a step fails after ``max_cutbacks`` halvings (all carry ``last_converged``).
+    """
+    opts = NewtonOptions(rtol, energy_tol, max_iter, max_cutbacks, line_search, max_line_search,
+                         linsolve.solver_name(solver), verbose)
+    if not (isinstance(t0, int | float) and math.isfinite(t0) and t0 >= 0):
+        raise ValueError(f"t0 must be a finite load factor >= 0; got {t0!r}")
+    factors = _load_factors(steps, t0)
+    start = time.perf_counter()
+    problem.pattern  # noqa: B018 - build the sparsity pattern once, before the loop
+    n = problem.space.n_dofs
+    u = np.zeros(n) if u0 is None else np.array(u0, dtype=float)
+    if u.shape != (n,):
+        raise ValueError(f"u0 must have shape ({n},); got {u.shape}")
+    if not np.all(np.isfinite(u)):
+        raise ValueError("u0 must be finite")
+    residual, _ = problem.assemble(u, t0, tangent=False, step=0)
+    result = Result(problem, solver=opts.solver)
+    result.timings = opts.timings
+    opts.timings["setup"] = time.perf_counter() - start
+    result.append(t0, u, residual, [])
+    _notify(callbacks, StepEvent(problem, 0, t0, u, result))
+    t, target_index = t0, 0
+    increment, failures = _nominal(factors, 0, t0), 0
     cached = None
     bar = tqdm(total=len(factors), disable=not progress, desc="load steps", leave=False)
     try:
@@ -186,43 +275,69 @@ def solve(solid: Solid, steps=10, *, rtol: float = 1e-8, energy_tol: float | Non
                 t_new = target
             step = len(result.load_factors)
             try:
-                u_new, residual, history, converged_state = _newton_step(solid, u, t, t_new, step, opts, cached)
+                u_new, residual, history, tangent = _newton_step(problem, u, t, t_new, step, opts, cached)
             except (_StepFailed, NonPositiveJacobianError, np.linalg.LinAlgError, ValueError) as err:
+                problem.rewind()
                 failures += 1
                 logger.info("step %d to t=%.4g failed (%s); cut-back %d", step, t_new, err, failures)
+                if isinstance(err.__cause__, SingularSystemError) and step == 1 and failures == 1 \
+                        and not _iterated(err):
+                    raise _singular(err.__cause__, step, t_new, result) from err
                 if failures > max_cutbacks:
                     raise _failure(err, step, t_new, result, max_cutbacks) from err
                 increment = 0.5 * (t_new - t)
                 continue
-            was_cut = failures > 0 or increment < _nominal(factors, target_index) * (1 - 1e-12)
+            was_cut = failures > 0 or increment < _nominal(factors, target_index, t0) * (1 - 1e-12)
             failures = 0
+            problem.commit()
             u, t = u_new, t_new
-            cached = converged_state
+            cached = tangent
             result.append(t, u, residual, history)
+            _notify(callbacks, StepEvent(problem, step, t, u, result))
             if t == target:
                 target_index += 1
                 bar.update(1)
             if target_index < len(factors):
-                nominal = _nominal(factors, target_index)
+                nominal = _nominal(factors, target_index, t0)
                 increment = min(2.0 * increment, nominal) if was_cut else nominal
     finally:
         bar.close()
-        if writer is not None:
-            writer.close()
+        for callback in callbacks:
+            close = getattr(callback, "close", None)
+            if close is not None:
+                close()
     return result
 
 
-def _nominal(factors: np.ndarray, index: int) -> float:
-    previous = factors[index - 1] if index > 0 else 0.0
+def _iterated(err: Exception) -> bool:
+    """True when the failed step had accepted an iteration before failing (not a start-state singularity)."""
+    return bool(getattr(err, "iterations_done", 0))
+
+
+def _nominal(factors: np.ndarray, index: int, t0: float) -> float:
+    previous = factors[index - 1] if index > 0 else t0
     return factors[index] - previous
 
 
+def _singular(cause: SingularSystemError, step: int, t: float, result: Result) -> SingularSystemError:
+    error = SingularSystemError(
+        f"the tangent is singular at the start state (load step {step}, load factor {t:.6g}): the body can move "
+        f"without resistance — add supports (Dirichlet conditions) that remove every rigid-body motion. ({cause})",
+        step, t)
+    error.last_converged = result
+    return error
+
+
 def _failure(err: Exception, step: int, t: float, result: Result, max_cutbacks: int) -> SolverError:
-    if isinstance(err, NonPositiveJacobianError):
-        error = NonPositiveJacobianError(err.elements, step, t)
-    elif isinstance(err, _StepFailed) and isinstance(err.__cause__, NonPositiveJacobianError):
-        cause = err.__cause__
-        error = NonPositiveJacobianError(cause.elements, step, t)
+    cause = err.__cause__ if isinstance(err, _StepFailed) else None
+    if isinstance(err, NonPositiveJacobianError) or isinstance(cause, NonPositiveJacobianError):
+        source = err if isinstance(err, NonPositiveJacobianError) else cause
+        error = NonPositiveJacobianError(source.elements, step, t)
+    elif isinstance(cause, SingularSystemError):
+        error = SingularSystemError(
+            f"load step {step} to load factor {t:.6g} failed after {max_cutbacks} cut-backs: {err} (a limit or "
+            f"bifurcation point, or parts without supports); last converged load factor "
+            f"{result.load_factors[-1]:.6g}", step, t)
     else:
         error = ConvergenceError(
             f"load step {step} to load factor {t:.6g} failed after {max_cutbacks} cut-backs: {err}; "

@@ -15,8 +15,9 @@ class Result:
     Step 0 is the reference state (load factor 0). ``step=-1`` is the last converged step.
     """
 
-    def __init__(self, solid, solver: str, writer=None) -> None:
-        self.solid, self.solver, self._writer = solid, solver, writer
+    def __init__(self, problem, solver: str) -> None:
+        self.solid, self.solver = problem, solver
+        self.problem = problem
         self.load_factors: list[float] = []
         self.solutions: list[np.ndarray] = []
         self.residuals: list[np.ndarray] = []
@@ -30,8 +31,6 @@ class Result:
         self.solutions.append(u.copy())
         self.residuals.append(residual.copy())
         self.histories.append(history)
-        if self._writer is not None:
-            self._writer.write(t, u)
 
     def __len__(self) -> int:
         return len(self.load_factors)

@@ -27,6 +27,8 @@ from __future__ import annotations
 import numpy as np
 import skfem as fem
 
+from .errors import TangledMeshError
+
 __all__ = ["Space", "element_family"]
 
 _FAMILIES = {
@@ -67,6 +69,7 @@ class Space:
         self.intorder = orders[order - 1] if intorder is None else int(intorder)
         self.element_u = quadratic() if order == 2 else linear()
         self.basis_u = fem.CellBasis(mesh, self.element_u, intorder=self.intorder)
+        check_reference_jacobian(mesh, self.basis_u)
         self.basis_p = None
         if formulation == "up":
             self.element_p = linear()
@@ -144,3 +147,34 @@ class Space:
         if facets.size and (facets.min() < 0 or facets.max() >= mesh.nfacets):
             raise ValueError(f"facet indices must lie in 0..{mesh.nfacets - 1}")
         return facets
+
+
+def check_reference_jacobian(mesh: fem.Mesh, basis: fem.CellBasis) -> None:
+    r"""Raise :class:`TangledMeshError` unless det(dX/dxi) has one sign over the mesh.
+
+    scikit-fem integrates with :math:`|\det J|`, so an element with a scrambled node order or a
+    node pushed past its neighbours would otherwise run and give wrong results silently. The sign
+    is checked at the quadrature points and at the reference element's corners; a mesh whose
+    elements are all negatively oriented is consistent and accepted. Simplices (affine maps) may be
+    oriented either way element by element (scikit-fem does not order their nodes); only degenerate
+    ones are rejected.
+    """
+    mapping = basis.mapping
+    corners = basis.elem.refdom.p
+    points = np.hstack([basis.quadrature[0], corners])
+    det = mapping.detDF(points)  # (nel, npoints)
+    det = np.broadcast_to(det, (mesh.nelements, points.shape[1])) if np.ndim(det) == 2 else \
+        np.broadcast_to(np.asarray(det).reshape(-1, 1), (mesh.nelements, points.shape[1]))
+    scale = np.abs(det).max()
+    if not np.all(np.isfinite(det)) or scale == 0:
+        raise TangledMeshError(np.flatnonzero(~np.isfinite(det).all(axis=1)), " (degenerate or non-finite)")
+    if isinstance(mesh, fem.MeshTet1 | fem.MeshTri1):
+        bad = np.flatnonzero(~(np.abs(det) > 1e-12 * scale).all(axis=1))
+        if bad.size:
+            raise TangledMeshError(bad, " (degenerate simplices)")
+        return
+    positive = (det > 1e-12 * scale).sum()
+    sign = 1.0 if positive >= det.size / 2 else -1.0
+    bad = np.flatnonzero(~(sign * det > 1e-12 * scale).all(axis=1))
+    if bad.size:
+        raise TangledMeshError(bad)

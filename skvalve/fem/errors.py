@@ -1,0 +1,67 @@
+"""Errors raised by the finite-element layer: bad meshes, bad problems and solver failures.
+
+Every solver failure derives from :class:`SolverError` and carries ``last_converged``, the
+:class:`~skvalve.fem.result.Result` up to the last converged load step (``None`` when the failure
+happened before the first step was attempted).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "SolverError", "ConvergenceError", "NonPositiveJacobianError", "SingularSystemError", "OutputError",
+    "TangledMeshError",
+]
+
+
+def _shown(ids: np.ndarray, limit: int = 10) -> str:
+    ids = np.asarray(ids).ravel()
+    return ", ".join(str(int(e)) for e in ids[:limit]) + (" ..." if ids.size > limit else "")
+
+
+class SolverError(RuntimeError):
+    """Base of solver failures; ``last_converged`` is the result up to the last converged step."""
+
+    last_converged = None
+
+
+class ConvergenceError(SolverError):
+    """Newton did not converge after the allowed step cut-backs."""
+
+
+class NonPositiveJacobianError(SolverError):
+    """J <= 0 (or not finite) at a quadrature point; names the elements and the load step."""
+
+    def __init__(self, elements: np.ndarray, step: int | None, load_factor: float | None, term: str = "") -> None:
+        self.elements = np.asarray(elements)
+        self.step, self.load_factor = step, load_factor
+        where = f" of {term}" if term else ""
+        super().__init__(
+            f"det F <= 0 (or not finite) in {self.elements.size} element(s){where} [{_shown(self.elements)}] "
+            f"at load step {step} (load factor {load_factor})"
+        )
+
+
+class SingularSystemError(SolverError):
+    """The tangent is singular: typically a body (or part of one) without enough supports."""
+
+    def __init__(self, message: str, step: int | None = None, load_factor: float | None = None) -> None:
+        self.step, self.load_factor = step, load_factor
+        super().__init__(message)
+
+
+class OutputError(SolverError):
+    """A step callback (output, checkpoint) failed; the converged steps so far are in ``last_converged``."""
+
+
+class TangledMeshError(ValueError):
+    """Elements whose reference Jacobian changes sign (scrambled node order, a node pushed outside)."""
+
+    def __init__(self, elements: np.ndarray, detail: str = "") -> None:
+        self.elements = np.asarray(elements)
+        super().__init__(
+            f"{self.elements.size} tangled element(s) [{_shown(self.elements)}]: the reference Jacobian det(dX/dxi) "
+            f"is not of one sign over the mesh at their quadrature points or corners{detail}; check their node "
+            "order and coordinates"
+        )

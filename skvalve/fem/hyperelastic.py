@@ -1,0 +1,98 @@
+r"""The solid term: the domain integral of a total-Lagrangian hyperelastic body (u or mixed u/p).
+
+Residual and tangent (reference configuration :math:`\Omega_0`, :math:`P = \partial\psi/\partial F`,
+:math:`F = I + \nabla_0 u`):
+
+.. math::
+
+    f^\text{int}_{ai} = \int_{\Omega_0} P_{iJ}\,\frac{\partial N_a}{\partial X_J}\,dV, \qquad
+    K_{ai,bk} = \int_{\Omega_0} \frac{\partial N_a}{\partial X_J}\,\mathbb{A}_{iJkL}\,
+                \frac{\partial N_b}{\partial X_L}\,dV,\qquad \mathbb{A} = \partial P/\partial F,
+
+plus, for the mixed formulation, the pressure rows of :mod:`skvalve.fem.constitutive`. Element
+forces and stiffness come from the compiled kernels of :mod:`skvalve.fem.kernels`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..kinematics import determinant
+from .constitutive import MaterialRegions
+from .errors import NonPositiveJacobianError
+from .kernels import element_forces, element_gradients, element_stiffness
+from .loads import embed_3d
+from .space import Space
+from .terms import Blocks, Contribution, Term
+
+__all__ = ["HyperelasticTerm"]
+
+
+class HyperelasticTerm(Term):
+    """Hyperelastic (or quadrature-point) materials on the elements of ``space``.
+
+    Parameters
+    ----------
+    space : the field's :class:`~skvalve.fem.space.Space`.
+    materials : the :class:`~skvalve.fem.constitutive.MaterialRegions` assigning laws to elements.
+    """
+
+    name = "solid"
+
+    def __init__(self, space: Space, materials: MaterialRegions) -> None:
+        self.space = space
+        self.materials = materials
+
+    def connectivity(self) -> list[np.ndarray]:
+        return [self.space.element_dofs]
+
+    def deformation_gradient(self, u: np.ndarray) -> np.ndarray:
+        """F at the quadrature points, shape (3, 3, nqp, nel) (F33 = 1 in plane strain)."""
+        sp_ = self.space
+        u_elem = u[: sp_.n_u][sp_.element_dofs[:, : sp_.nb_u * sp_.dim]].reshape(sp_.nel, sp_.nb_u, sp_.dim)
+        return embed_3d(element_gradients(u_elem, sp_.dN))
+
+    def assemble(self, u: np.ndarray, t: float, tangent: bool, step: int | None) -> Contribution:
+        sp_ = self.space
+        d, nb = sp_.dim, sp_.nb_u
+        F = self.deformation_gradient(u)
+        bad = ~(determinant(F) > 0.0)
+        if np.any(bad):
+            raise NonPositiveJacobianError(np.flatnonzero(bad.any(axis=0)), step, t, self.name)
+        p = None
+        if sp_.formulation == "up":
+            p_elem = u[sp_.element_dofs[:, nb * d:]]  # (nel, nbp)
+            p = np.einsum("eqa,ea->qe", sp_.Np, p_elem)
+        P, A, mixed = self.materials.evaluate(F, p, tangent)
+        if not np.all(np.isfinite(P)):
+            bad_elements = np.flatnonzero(~np.isfinite(P).all(axis=(0, 1, 2)))
+            raise NonPositiveJacobianError(bad_elements, step, t, self.name)
+        fe = np.zeros((sp_.nel, sp_.ndofe))
+        fe[:, : nb * d] = element_forces(P[:d, :d], sp_.dN, sp_.dx)
+        ke = None
+        if tangent:
+            ke = np.zeros((sp_.nel, sp_.ndofe, sp_.ndofe))
+            element_stiffness(A[:, :, :d, :d, :d, :d], sp_.dN, sp_.dx, ke)
+        if mixed is not None:
+            Jbar, compliance, J, cof = mixed
+            wN = sp_.Np * sp_.dx[:, :, None]  # (nel, nqp, nbp)
+            fe[:, nb * d:] = np.einsum("eqa,qe->ea", wN, Jbar - J)
+            if tangent:
+                coupling = -np.einsum("ijqe,eqaj,eqb->eaib", cof[:d, :d], sp_.dN, wN).reshape(sp_.nel, nb * d, -1)
+                ke[:, : nb * d, nb * d:] = coupling
+                ke[:, nb * d:, : nb * d] = coupling.transpose(0, 2, 1)
+                ke[:, nb * d:, nb * d:] = -np.einsum("eqa,qe,eqb->eab", wN, compliance, sp_.Np)
+        internal = np.bincount(sp_.element_dofs.ravel(), fe.ravel(), minlength=sp_.n_dofs)
+        return Contribution(internal=internal, blocks=[Blocks(sp_.element_dofs, ke)])
+
+    def commit(self) -> None:
+        for region in self.materials.regions:
+            commit = getattr(region.material, "commit", None)
+            if commit is not None:
+                commit()
+
+    def rewind(self) -> None:
+        for region in self.materials.regions:
+            rewind = getattr(region.material, "rewind", None)
+            if rewind is not None:
+                rewind()

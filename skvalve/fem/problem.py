@@ -1,0 +1,230 @@
+r"""A problem: one displacement (and pressure) field, Dirichlet constraints and a sum of terms.
+
+The Newton driver (:mod:`skvalve.fem.newton`) sees only this class's small protocol:
+:meth:`Problem.assemble` (residual and a :class:`Tangent`), :meth:`Problem.constrained`,
+:meth:`Problem.commit` and :meth:`Problem.rewind`. Reactions are the residual at the constrained
+dofs, :math:`r = f_\text{int} - f_\text{ext}`: the force the supports exert on the body.
+
+Assembly: the blocks of every term are added into one CSR matrix of the free dofs whose pattern
+and entry positions are built once per set of constraints (terms' connectivities stacked, padded
+with -1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .kernels import csr_pattern, scatter_add
+from .loads import Dirichlet
+from .space import Space
+from .terms import Contribution, Term
+
+__all__ = ["Problem", "Tangent", "Pattern"]
+
+
+@dataclass
+class Pattern:
+    """Free/fixed dof split and the CSR layout of the free-dof tangent."""
+
+    fixed: np.ndarray
+    free: np.ndarray
+    reduced: np.ndarray  # global dof -> free index, -1 if fixed
+    indptr: np.ndarray
+    indices: np.ndarray
+    positions: list[list[np.ndarray]]  # per term, per block: (n, m, m) CSR positions
+
+
+@dataclass
+class Tangent:
+    """The terms' contributions at one state: enough to form K_ff or apply K to a vector."""
+
+    contributions: list[Contribution]
+
+
+class Problem:
+    """A field ``space`` with Dirichlet constraints and a list of terms.
+
+    Parameters
+    ----------
+    space : the :class:`~skvalve.fem.space.Space` (displacement, and pressure for mixed u/p).
+    terms : initial terms (more with :meth:`add_term`).
+
+    Examples
+    --------
+    >>> import skfem
+    >>> from skvalve.fem import Problem, Space, HyperelasticTerm, MaterialRegions, solve
+    >>> from skvalve.materials import NeoHookean
+    >>> mesh = skfem.MeshHex().refined(1)
+    >>> space = Space(mesh)
+    >>> problem = Problem(space, [HyperelasticTerm(space, MaterialRegions(mesh, NeoHookean(1.0, 10.0)))])
+    >>> _ = problem.add_dirichlet(lambda X: X[0] == 0.0, 0.0)
+    >>> _ = problem.add_dirichlet(lambda X: X[0] == 1.0, 0.1, components=[0])
+    >>> round(float(solve(problem, steps=2, progress=False).reaction(lambda X: X[0] == 1.0)[0]), 4)
+    0.3466
+    """
+
+    def __init__(self, space: Space, terms=()) -> None:
+        self.space = space
+        self.mesh = space.mesh
+        self.dim = space.dim
+        self.dirichlet: list[Dirichlet] = []
+        self.terms: list[Term] = []
+        self._pattern: Pattern | None = None
+        for term in terms:
+            self.add_term(term)
+
+    # ------------------------------------------------------------ definitions
+    def add_term(self, term: Term) -> Term:
+        """Add a term (anything following :class:`~skvalve.fem.terms.Term`); returns it."""
+        if not hasattr(term, "assemble") or not hasattr(term, "connectivity"):
+            raise TypeError(f"a term needs assemble() and connectivity(); got {type(term).__name__}")
+        self.terms.append(term)
+        self._pattern = None
+        return term
+
+    def add_dirichlet(self, where=None, value=0.0, components=None, *, nodes=None, ramp: bool = True):
+        """Prescribe displacement components on a boundary.
+
+        ``where``: boundary name, facet indices or ``X -> bool`` on dof locations (shape (dim, n));
+        or ``nodes=`` scalar dof indices. ``value``: number or per-component array (times the
+        load factor ``t`` when ``ramp``) or a callable ``value(X, t) -> (dim, n)`` array,
+        e.g. a rigid rotation ``(R(theta t) - I)(X - X0)``. ``components``: indices (default all).
+        """
+        if (where is None) == (nodes is None):
+            raise ValueError("give exactly one of where= (facets/boundary/predicate) or nodes=")
+        scalar = self.space.scalar_dofs_on(where) if nodes is None else np.unique(np.asarray(nodes, dtype=int))
+        if scalar.size == 0:
+            raise ValueError(f"add_dirichlet: the selection {where!r} contains no dofs")
+        if scalar.min() < 0 or scalar.max() >= self.space.n_scalar:
+            raise ValueError(f"nodes must lie in 0..{self.space.n_scalar - 1}")
+        self.dirichlet.append(Dirichlet(self.space, scalar, components, value, ramp))
+        self._pattern = None
+        return self
+
+    # ---------------------------------------------------------- constraints
+    def constrained(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Constrained dofs (sorted, unique) and their values at load factor ``t`` (later wins)."""
+        if not self.dirichlet:
+            return np.zeros(0, dtype=np.int64), np.zeros(0)
+        dofs = np.concatenate([bc.dofs.ravel() for bc in self.dirichlet]).astype(np.int64)
+        vals = np.concatenate([np.asarray(bc.values(t), dtype=float).ravel() for bc in self.dirichlet])
+        # the last definition of a dof wins: unique over the reversed order
+        unique, first = np.unique(dofs[::-1], return_index=True)
+        return unique, vals[::-1][first]
+
+    @property
+    def pattern(self) -> Pattern:
+        """Free-dof CSR pattern and the CSR position of every block entry (built once)."""
+        if self._pattern is None:
+            self._pattern = self._build_pattern()
+        return self._pattern
+
+    def _build_pattern(self) -> Pattern:
+        n = self.space.n_dofs
+        fixed, _ = self.constrained(0.0)
+        reduced = np.full(n, -1, dtype=np.int64)
+        free = np.setdiff1d(np.arange(n), fixed)
+        reduced[free] = np.arange(free.size)
+        connectivities = [[np.asarray(c, dtype=np.int64) for c in term.connectivity()] for term in self.terms]
+        flat = [c for group in connectivities for c in group if c.size]
+        width = max((c.shape[1] for c in flat), default=1)
+        stacked = np.full((sum(c.shape[0] for c in flat), width), -1, dtype=np.int64)
+        row = 0
+        for c in flat:
+            stacked[row: row + c.shape[0], : c.shape[1]] = reduced[c]
+            row += c.shape[0]
+        indptr, indices, positions = csr_pattern(stacked, free.size)
+        per_term, row = [], 0
+        for group in connectivities:
+            blocks = []
+            for c in group:
+                if c.size == 0:
+                    blocks.append(np.zeros((0, 0, 0), dtype=np.int64))
+                    continue
+                m = c.shape[1]
+                blocks.append(np.ascontiguousarray(positions[row: row + c.shape[0], :m, :m]))
+                row += c.shape[0]
+            per_term.append(blocks)
+        return Pattern(fixed, free, reduced, indptr.astype(np.int32), indices.astype(np.int32), per_term)
+
+    # ---------------------------------------------------------------- assembly
+    @property
+    def symmetric(self) -> bool:
+        """True when every term's tangent is symmetric."""
+        return all(getattr(term, "symmetric", True) for term in self.terms)
+
+    def assemble(self, u: np.ndarray, t: float, tangent: bool = True, step: int | None = None,
+                 reuse: Tangent | None = None) -> tuple[np.ndarray, Tangent]:
+        """Residual (all dofs) and the terms' contributions at ``u`` and load factor ``t``.
+
+        ``reuse``: contributions of an earlier call at the same ``u``; only load-dependent terms
+        are re-evaluated. ``self.internal_forces`` / ``self.external_forces`` hold the two parts.
+        """
+        n = self.space.n_dofs
+        internal, external = np.zeros(n), np.zeros(n)
+        contributions = []
+        for k, term in enumerate(self.terms):
+            if reuse is not None and not getattr(term, "load_dependent", False):
+                contribution = reuse.contributions[k]
+            else:
+                contribution = term.assemble(u, t, tangent, step)
+            if contribution.internal is not None:
+                internal += contribution.internal
+            if contribution.external is not None:
+                external += contribution.external
+            contributions.append(contribution)
+        self.internal_forces, self.external_forces = internal, external
+        return internal - external, Tangent(contributions)
+
+    def tangent_matrix(self, tangent: Tangent) -> sp.csr_matrix:
+        """Free-dof tangent K_ff from the contributions of :meth:`assemble`."""
+        pat = self.pattern
+        data = np.zeros(pat.indices.size)
+        extra = None
+        for positions, contribution in zip(pat.positions, tangent.contributions, strict=True):
+            for pos, block in zip(positions, contribution.blocks, strict=True):
+                if block.matrices is None:
+                    raise ValueError("tangent_matrix needs contributions assembled with tangent=True")
+                if pos.size:
+                    scatter_add(np.ascontiguousarray(block.matrices), pos, data)
+            if contribution.matrix is not None:
+                part = sp.csr_matrix(contribution.matrix)[pat.free][:, pat.free]
+                extra = part if extra is None else extra + part
+        nfree = pat.free.size
+        K = sp.csr_matrix((data, pat.indices, pat.indptr), shape=(nfree, nfree))
+        return K if extra is None else (K + extra).tocsr()
+
+    def apply(self, tangent: Tangent, vector: np.ndarray) -> np.ndarray:
+        """Full tangent (all dofs) times ``vector``."""
+        out = np.zeros(self.space.n_dofs)
+        for contribution in tangent.contributions:
+            for block in contribution.blocks:
+                if block.matrices is None or block.dofs.size == 0:
+                    continue
+                local = np.einsum("emn,en->em", block.matrices, vector[block.dofs])
+                out += np.bincount(block.dofs.ravel(), local.ravel(), minlength=out.size)
+            if contribution.matrix is not None:
+                out += contribution.matrix @ vector
+        return out
+
+    # ------------------------------------------------------------------ state
+    def commit(self) -> None:
+        """Accept the converged state of every stateful term."""
+        for term in self.terms:
+            term.commit()
+
+    def rewind(self) -> None:
+        """Return every stateful term to its last committed state."""
+        for term in self.terms:
+            term.rewind()
+
+    @property
+    def materials(self):
+        """The material regions of the (single) solid term, for stress output."""
+        solids = [term for term in self.terms if hasattr(term, "materials")]
+        if len(solids) != 1:
+            raise AttributeError(f"the problem has {len(solids)} solid terms; stress output needs exactly one")
+        return solids[0].materials

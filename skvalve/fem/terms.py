@@ -1,0 +1,88 @@
+r"""The protocol of a problem's terms: each adds a residual and a tangent on one displacement field.
+
+A :class:`~skvalve.fem.problem.Problem` is a field and a sum of terms,
+
+.. math::
+
+    R(u, t) = \sum_k \big(f^\text{int}_k(u) - f^\text{ext}_k(u, t)\big), \qquad
+    K(u, t) = \sum_k \frac{\partial}{\partial u}\big(f^\text{int}_k - f^\text{ext}_k\big),
+
+(solid regions, follower pressure, nodal loads, trusses, contact, multipoint constraints). A term
+returns a :class:`Contribution`: its internal and external force vectors and its tangent as element
+blocks on a connectivity fixed for the problem's life (the sparsity pattern is built once from
+:meth:`Term.connectivity`), plus an optional sparse matrix for connectivity that changes (contact).
+Terms holding state (warm-started RVEs, active contact sets) accept it in :meth:`Term.commit` after
+a converged load step and restore it in :meth:`Term.rewind` after a failed attempt.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+__all__ = ["Blocks", "Contribution", "Term"]
+
+
+@dataclass
+class Blocks:
+    r"""Element-wise tangent blocks: ``matrices[e]`` couples the global dofs ``dofs[e]``.
+
+    Parameters
+    ----------
+    dofs : (n, m) int array of global dof numbers.
+    matrices : (n, m, m) array of :math:`\partial R_{dofs[e, a]}/\partial u_{dofs[e, b]}`, or None
+        when no tangent was requested.
+    """
+
+    dofs: np.ndarray
+    matrices: np.ndarray | None = None
+
+
+@dataclass
+class Contribution:
+    """What one term adds: forces (residual = internal - external) and tangent.
+
+    Parameters
+    ----------
+    internal, external : (n_dofs,) force vectors, or None for zero.
+    blocks : tangent blocks in the order of :meth:`Term.connectivity`.
+    matrix : extra tangent on all dofs (n_dofs, n_dofs) for connectivity that changes.
+    """
+
+    internal: np.ndarray | None = None
+    external: np.ndarray | None = None
+    blocks: list[Blocks] = field(default_factory=list)
+    matrix: sp.spmatrix | None = None
+
+
+class Term:
+    """Base class of problem terms (no-op state handling).
+
+    Attributes
+    ----------
+    load_dependent : True when the residual depends on the load factor ``t`` (loads, moved
+        targets); the Newton predictor re-evaluates only those at a converged state.
+    symmetric : True when the term's tangent is symmetric (lets the solver use a symmetric
+        factorisation when every term is).
+    name : shown in error messages.
+    """
+
+    load_dependent: bool = False
+    symmetric: bool = True
+    name: str = "term"
+
+    def connectivity(self) -> list[np.ndarray]:
+        """The (n, m) dof arrays of the blocks :meth:`assemble` returns, in the same order."""
+        return []
+
+    def assemble(self, u: np.ndarray, t: float, tangent: bool, step: int | None) -> Contribution:
+        """Forces and (if ``tangent``) the tangent at state ``u`` and load factor ``t``."""
+        raise NotImplementedError
+
+    def commit(self) -> None:
+        """Accept the current (converged) state."""
+
+    def rewind(self) -> None:
+        """Return to the last committed state (after a failed attempt)."""
