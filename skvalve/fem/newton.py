@@ -250,7 +250,7 @@ def solve(problem: Problem, steps=10, *, rtol: float = 1e-8, energy_tol: float |
         raise ValueError(f"t0 must be a finite load factor >= 0; got {t0!r}")
     factors = _load_factors(steps, t0)
     start = time.perf_counter()
-    problem.pattern  # noqa: B018 - build the sparsity pattern once, before the loop
+    problem.check_supports()  # also builds the sparsity pattern once, before the loop
     n = problem.space.n_dofs
     u = np.zeros(n) if u0 is None else np.array(u0, dtype=float)
     if u.shape != (n,):

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from .errors import SingularSystemError
 from .kernels import csr_pattern, scatter_add
 from .loads import Dirichlet
 from .space import Space
@@ -149,6 +150,51 @@ class Problem:
                 row += c.shape[0]
             per_term.append(blocks)
         return Pattern(fixed, free, reduced, indptr.astype(np.int32), indices.astype(np.int32), per_term)
+
+    def check_supports(self) -> None:
+        """Raise :class:`SingularSystemError` if the constraints leave a rigid-body motion free.
+
+        The rigid motions of the displacement dofs (translations, and rotations about the
+        centroid) restricted to the constrained dofs must have full rank. Terms that support the
+        body elastically (springs, contact with an obstacle) set ``supports = True`` to skip this.
+        """
+        if any(getattr(term, "supports", False) for term in self.terms):
+            return
+        fixed = self.pattern.fixed
+        space = self.space
+        X = space.dof_coordinates
+        X = X - X.mean(axis=1, keepdims=True)
+        d = space.dim
+        modes, names = [], []
+        for i in range(d):
+            mode = np.zeros((d, X.shape[1]))
+            mode[i] = 1.0
+            modes.append(mode)
+            names.append(f"translation along {'xyz'[i]}")
+        axes = [(1, 2, "x"), (2, 0, "y"), (0, 1, "z")] if d == 3 else [(0, 1, "z")]
+        for a, b, axis in axes:
+            mode = np.zeros((d, X.shape[1]))
+            mode[a], mode[b] = -X[b], X[a]
+            modes.append(mode)
+            names.append(f"rotation about {axis}")
+        R = np.zeros((space.n_dofs, len(modes)))
+        for k, mode in enumerate(modes):
+            R[: space.n_u, k] = mode.T.ravel()
+        restricted = R[fixed]
+        if restricted.size and np.linalg.matrix_rank(restricted, tol=1e-10 * np.abs(restricted).max()) == len(modes):
+            return
+        # name the free motions: the null space of the restricted modes
+        if restricted.size:
+            _, sv, vt = np.linalg.svd(restricted)
+            rank = int((sv > 1e-10 * sv.max()).sum()) if sv.size else 0
+            null = vt[rank:]
+        else:
+            null = np.eye(len(modes))
+        free = [names[int(np.argmax(np.abs(v)))] for v in null]
+        raise SingularSystemError(
+            f"the Dirichlet conditions leave {len(null)} rigid-body motion(s) free ({', '.join(free)}): the tangent "
+            "is singular. Add supports that remove them (or mark a supporting term with supports = True)."
+        )
 
     # ---------------------------------------------------------------- assembly
     @property

@@ -6,6 +6,7 @@ Continuum laws share the interface of :class:`~skvalve.materials.base.Hyperelast
 
 from .base import Hyperelastic, VolumetricEnergy
 from .bimodular_neo_hookean import BimodularNeoHookean
+from .exponential_fiber import ExponentialFiber
 from .incompressible_neo_hookean import IncompressibleNeoHookean
 from .lee_sacks import LeeSacks
 from .neo_hookean import NeoHookean
@@ -19,12 +20,6 @@ __all__ = [
     "Ogden",
     "LeeSacks",
     "BimodularNeoHookean",
+    "ExponentialFiber",
 ]
 
-# Laws written by parallel work streams are exported when present.
-try:  # noqa: SIM105
-    from .exponential_fiber import ExponentialFiber  # noqa: F401
-
-    __all__.append("ExponentialFiber")
-except ImportError:  # pragma: no cover
-    pass
