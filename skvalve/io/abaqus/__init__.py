@@ -80,10 +80,18 @@ def _data_folder() -> Path | None:
 
 
 def trivalve_input() -> Path | None:
-    """The Texas TriValve 1.0 diseased input if present: ``$SKVALVE_TRIVALVE`` or ``../shared/data/...``."""
+    """The Texas TriValve 1.0 diseased input if present: ``$SKVALVE_TRIVALVE`` or ``../shared/data/...``.
+
+    ``$SKVALVE_TRIVALVE`` may name the ``.inp`` file or its folder (the diseased input in it, or one level
+    down as in ``texas_trivalve_1.1/Diseased/``).
+    """
     env = os.environ.get("SKVALVE_TRIVALVE")
     if env and Path(env).is_file():
         return Path(env)
+    if env and Path(env).is_dir():
+        name = TRIVALVE_FILES["1.0-diseased"].name
+        found = [Path(env) / name, *sorted(Path(env).glob(f"*/{name}"))]
+        return next((path for path in found if path.is_file()), None)
     folder = _data_folder()
     if folder is not None and (folder / TRIVALVE_FILES["1.0-diseased"]).is_file():
         return folder / TRIVALVE_FILES["1.0-diseased"]

@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 __all__ = ["Location", "AbaqusParseError"]
 
 
-@dataclass(frozen=True)
-class Location:
+class Location(NamedTuple):
     """A line of an input file (1-based), for messages and for tracing data back to the file."""
 
     file: Path

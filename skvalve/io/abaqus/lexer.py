@@ -22,21 +22,26 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
 
 from .errors import AbaqusParseError, Location
 
-__all__ = ["DataLine", "Card", "read_cards", "split_fields", "parse_float", "parse_int", "data_values"]
+__all__ = ["DataLine", "Card", "read_cards", "split_fields", "parse_float", "parse_int", "data_values", "fast_table"]
 
 _FLOAT = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
 _INT = re.compile(r"[+-]?\d+", re.ASCII)
 _SPACES = re.compile(r"\s+")
+_NOT_FLOAT_CHARS = re.compile(r"[^0-9eE+\-.,\s]", re.ASCII)
+_NOT_INT_CHARS = re.compile(r"[^0-9+\-,\s]", re.ASCII)
 #: Nesting depth of ``*Include`` beyond which the input is rejected (besides the cycle check).
 MAX_INCLUDE_DEPTH = 32
 
 
-@dataclass
-class DataLine:
+class DataLine(NamedTuple):
     """One data line: its text (stripped) and where it is."""
 
     text: str
@@ -56,7 +61,14 @@ class Card:
     parameters: dict[str, str]
     flags: list[str]
     location: Location
-    data: list[DataLine] = field(default_factory=list)
+    texts: list[str] = field(default_factory=list)
+    numbers: list[int] = field(default_factory=list)
+
+    @cached_property
+    def data(self) -> list[DataLine]:
+        """The data lines with their locations (built on first use; large blocks read ``texts``)."""
+        file = self.location.file
+        return [DataLine(text, Location(file, number)) for text, number in zip(self.texts, self.numbers, strict=True)]
 
     def error(self, message: str, location: Location | None = None) -> AbaqusParseError:
         """An :class:`AbaqusParseError` for this card (at ``location``, default the keyword line)."""
@@ -154,9 +166,9 @@ def read_cards(path: Path, _stack: tuple[Path, ...] = ()) -> list[Card]:
     cards: list[Card] = []
     current: Card | None = None
     continued: tuple[str, Location] | None = None
+    last = len(lines)
     for number, line in enumerate(lines, start=1):
         text = line.strip()
-        location = Location(path, number)
         if continued is not None:
             if not text or text.startswith("*"):
                 raise AbaqusParseError("keyword line ends with a comma but is not continued", continued[1])
@@ -164,20 +176,24 @@ def read_cards(path: Path, _stack: tuple[Path, ...] = ()) -> list[Card]:
             continued = None
         elif not text or text.startswith("**"):
             continue
-        elif not text.startswith("*"):
+        elif text[0] != "*":
             if current is None:
-                raise AbaqusParseError(f"data line before any keyword: {text[:40]!r}", location)
-            if unterminated and number == len(lines):
-                raise current.error("the file ends inside this data line (no final newline): truncated?", location)
-            current.data.append(DataLine(text, location))
+                raise AbaqusParseError(f"data line before any keyword: {text[:40]!r}", Location(path, number))
+            if unterminated and number == last:
+                raise current.error("the file ends inside this data line (no final newline): truncated?",
+                                    Location(path, number))
+            current.texts.append(text)
+            current.numbers.append(number)
             continue
+        else:
+            location = Location(path, number)
         if text.endswith(","):
             continued = (text, location)
             continue
         current = _parse_keyword_line(text, location)
         if current.keyword == "include":
             target = current.require("input")
-            if current.data:
+            if current.texts:
                 raise current.error("*Include takes no data lines")
             cards.extend(read_cards(path.parent / target, (*_stack, resolved)))
             current = None
@@ -225,3 +241,31 @@ def data_values(card: Card, blank: float | None = 0.0) -> list[float]:
             else:
                 values.append(parse_float(token, card, line.location))
     return values
+
+
+def fast_table(card: Card, columns: int, integer: bool) -> np.ndarray | None:
+    """The data of ``card`` as an (n, columns) array when every line is a plain row of ``columns`` numbers.
+
+    A quick path for large node and element blocks: None whenever anything is irregular (blank or
+    missing fields, a continuation, a character outside ASCII digits, signs, ``.``, ``e``, or a value that
+    is not finite), and the caller then reads line by line with exact error messages.
+    """
+    texts = card.texts
+    if not texts:
+        return None
+    pattern = _NOT_INT_CHARS if integer else _NOT_FLOAT_CHARS
+    if pattern.search("\n".join(texts)):
+        return None
+    rows = [text.split(",") for text in texts]
+    for row in rows:
+        if len(row) == columns + 1 and not row[-1].strip():
+            row.pop()
+        if len(row) != columns:
+            return None
+    try:
+        table = np.array(rows, dtype=np.int64 if integer else float)
+    except (ValueError, OverflowError):
+        return None
+    if not integer and not np.all(np.isfinite(table)):
+        return None
+    return table

@@ -6,7 +6,7 @@ import numpy as np
 
 from .elements import FACE_LABELS, NODES_PER_ELEMENT, SHELL_FACE_LABELS, is_shell_like
 from .errors import Location
-from .lexer import _INT, Card, parse_float, parse_int, split_fields
+from .lexer import _INT, Card, fast_table, parse_float, parse_int, split_fields
 from .mesh import MeshScope
 from .model import ElementBlock, Section, Surface, SurfaceFaces
 
@@ -62,6 +62,18 @@ def read_nodes(card: Card, scope: MeshScope) -> None:
     """``*Node``: label and up to three coordinates per line (missing coordinates are 0)."""
     if card.parameters.get("system", "R").upper() != "R":
         raise card.error("only rectangular nodal coordinates (SYSTEM=R) are supported")
+    table = fast_table(card, 4, integer=False)
+    if table is not None and all(_INT.fullmatch(text.split(",", 1)[0].strip()) for text in card.texts):
+        labels, xyz = table[:, 0].astype(np.int64), table[:, 1:]
+    else:
+        labels, xyz = _read_node_lines(card)
+    keep = scope.keep_last(labels, card, "node")
+    indices = scope.add_nodes(labels[keep], xyz[keep], card)
+    if "nset" in card.parameters:
+        scope.add_to_node_set(card.require("nset"), indices, card.location)
+
+
+def _read_node_lines(card: Card) -> tuple[np.ndarray, np.ndarray]:
     n = len(card.data)
     labels = np.empty(n, np.int64)
     xyz = np.zeros((n, 3))
@@ -74,10 +86,7 @@ def read_nodes(card: Card, scope: MeshScope) -> None:
         for col, token in enumerate(fields[1:]):
             if token:
                 xyz[row, col] = parse_float(token, card, line.location, "coordinate")
-    keep = scope.keep_last(labels, card, "node")
-    indices = scope.add_nodes(labels[keep], xyz[keep], card)
-    if "nset" in card.parameters:
-        scope.add_to_node_set(card.require("nset"), indices, card.location)
+    return labels, xyz
 
 
 def read_elements(card: Card, scope: MeshScope) -> None:
@@ -86,6 +95,20 @@ def read_elements(card: Card, scope: MeshScope) -> None:
     if element_type not in NODES_PER_ELEMENT:
         raise card.error(f"unsupported element type {element_type}")
     per_element = NODES_PER_ELEMENT[element_type]
+    table = fast_table(card, per_element + 1, integer=True)
+    if table is None:
+        table = _read_element_lines(card, element_type, per_element)
+    table = table[scope.keep_last(table[:, 0], card, "element")]
+    where = card.data[0].location if card.data else card.location
+    connectivity = _node_columns(table[:, 1:], scope, card, where)
+    elset = card.parameters.get("elset") or None
+    block = ElementBlock(element_type, scope.name, table[:, 0], connectivity, scope.n_elements, elset, card.location)
+    scope.add_block(block, card)
+    if elset:
+        scope.add_to_element_set(elset, block.indices, card.location)
+
+
+def _read_element_lines(card: Card, element_type: str, per_element: int) -> np.ndarray:
     rows: list[list[int]] = []
     pending: list[int] = []
     for line in card.data:
@@ -105,24 +128,15 @@ def read_elements(card: Card, scope: MeshScope) -> None:
                              line.location)
     if pending:
         raise card.error(f"element {pending[0]} is cut short", card.data[-1].location)
-    table = np.array(rows, np.int64).reshape(-1, per_element + 1)
-    table = table[scope.keep_last(table[:, 0], card, "element")]
-    where = card.data[0].location if card.data else card.location
-    connectivity = np.empty((len(table), per_element), np.int64)
-    for column in range(per_element):
-        connectivity[:, column] = _node_columns(table[:, column + 1], scope, card, where)
-    elset = card.parameters.get("elset") or None
-    block = ElementBlock(element_type, scope.name, table[:, 0], connectivity, scope.n_elements, elset, card.location)
-    scope.add_block(block, card)
-    if elset:
-        scope.add_to_element_set(elset, block.indices, card.location)
+    return np.array(rows, np.int64).reshape(-1, per_element + 1)
 
 
 def _node_columns(labels: np.ndarray, scope: MeshScope, card: Card, where: Location) -> np.ndarray:
     found = scope.node_index.find(labels)
     if np.any(found < 0):
-        row = int(np.flatnonzero(found < 0)[0])
-        raise card.error(f"element line {row + 1} of the block refers to undefined node {int(labels[row])}", where)
+        row, column = (int(i[0]) for i in np.nonzero(found < 0))
+        raise card.error(f"element {row + 1} of the block refers to undefined node {int(labels[row, column])}",
+                         where)
     return found
 
 
@@ -146,29 +160,44 @@ def read_set(card: Card, scope: MeshScope) -> None:
     if instance is not None and not scope.instances:
         raise card.error("INSTANCE= is only allowed in the assembly")
     chunks: list[np.ndarray] = [np.empty(0, np.int64)]
+    labels: list[int] = []
+    label_lines: list[Location] = []
     for line in card.data:
         fields = split_fields(line.text)
         if "generate" in card.flags:
-            labels = _generate(fields, card, line.location)
-            if instance is not None:
-                inst, part = _instance_scope(scope, instance, card, line.location)
-                index = part.node_index if nodes else part.element_index
-                offset = inst.node_offset if nodes else inst.element_offset
-                chunks.append(index.lookup(labels, card, line.location, "node" if nodes else "element") + offset)
-            else:
-                index = scope.node_index if nodes else scope.element_index
-                chunks.append(index.lookup(labels, card, line.location, "node" if nodes else "element"))
+            generated = _generate(fields, card, line.location)
+            chunks.append(_labels_to_indices(generated, [line.location] * len(generated), scope, card, nodes,
+                                             instance))
             continue
         for token in fields:
             if not token:
                 raise card.error("blank field in a set definition", line.location)
-            resolve = resolve_nodes if nodes else resolve_elements
-            chunks.append(resolve(token, scope, card, line.location, instance))
+            if _INT.fullmatch(token):
+                labels.append(int(token))
+                label_lines.append(line.location)
+            else:
+                resolve = resolve_nodes if nodes else resolve_elements
+                chunks.append(resolve(token, scope, card, line.location, instance))
+    if labels:
+        chunks.append(_labels_to_indices(np.array(labels, np.int64), label_lines, scope, card, nodes, instance))
     indices = np.concatenate(chunks)
     if nodes:
         scope.add_to_node_set(name, indices, card.location)
     else:
         scope.add_to_element_set(name, indices, card.location)
+
+
+def _labels_to_indices(labels: np.ndarray, lines: list[Location], scope: MeshScope, card: Card, nodes: bool,
+                       instance: str | None) -> np.ndarray:
+    offset, target = 0, scope
+    if instance is not None:
+        inst, target = _instance_scope(scope, instance, card, lines[0])
+        offset = inst.node_offset if nodes else inst.element_offset
+    found = (target.node_index if nodes else target.element_index).find(labels)
+    if np.any(found < 0):
+        first = int(np.flatnonzero(found < 0)[0])
+        raise card.error(f"unknown {'node' if nodes else 'element'} {int(labels[first])}", lines[first])
+    return found + offset
 
 
 def read_surface(card: Card, scope: MeshScope) -> None:

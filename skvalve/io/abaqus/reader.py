@@ -90,7 +90,8 @@ def _end_instance(card: Card, state: ParseState) -> None:
         raise opened.error(f"unknown part {part_name!r}")
     if name.upper() in state.assembly.instances:
         raise opened.error(f"instance {name!r} is defined twice")
-    rows = [data_values(Card(opened.keyword, {}, [], line.location, [line]), blank=None) for line in opened.data]
+    rows = [data_values(Card(opened.keyword, {}, [], line.location, [line.text], [line.location.line]), blank=None)
+            for line in opened.data]
     if len(rows) > 2 or (rows and len(rows[0]) != 3) or (len(rows) == 2 and len(rows[1]) != 7):
         raise opened.error("instance data: a translation line (3 values) and a rotation line (a, b, angle: 7)")
     translation = np.array(rows[0]) if rows else np.zeros(3)
