@@ -49,6 +49,7 @@ from numpy.typing import ArrayLike
 
 from ..kinematics import Array
 from .base import check_nonnegative, check_positive
+from .derivatives import InvariantDerivatives
 from .incompressible_neo_hookean import IncompressibleNeoHookean
 from .isotropic import IsotropicInvariantLaw, Partials, outer
 
@@ -144,6 +145,22 @@ class BimodularNeoHookean(IsotropicInvariantLaw):
         S = mu * S1 + 2.0 * d_mu * psi1 * A
         CC = mu * CC1 + 2.0 * d_mu * (outer(S1, A) + outer(A, S1)) + 4.0 * dd_mu * psi1 * outer(A, A)
         return S, CC
+
+    def invariant_derivatives(self, I1bar: Array, J: Array, C: Array) -> InvariantDerivatives:
+        r"""Partials of :math:`\psi = \mu(I_4)(\bar I_1 - 3)/2` in :math:`(\bar I_1, J, I_4)` (fused kernel).
+
+        :math:`\psi_{,1} = \mu/2`, :math:`\psi_{,4} = \mu'\psi_1`, :math:`\psi_{,14} = \mu'/2`,
+        :math:`\psi_{,44} = \mu''\psi_1` (smoothed switch); the published switch has only :math:`\psi_{,1}`.
+        """
+        if self.smoothing == 0.0:
+            return super().invariant_derivatives(I1bar, J, C)
+        mu, d_mu, dd_mu = (np.broadcast_to(x, np.shape(J)) for x in self._smooth_modulus(C))
+        psi1 = 0.5 * (I1bar - 3.0)
+        zero = np.zeros_like(J)
+        a = self.direction  # batch axes aligned from the right, as in fibre_stretch_squared
+        a = a.reshape((3,) + (1,) * (np.ndim(J) + 1 - a.ndim) + a.shape[1:])
+        return InvariantDerivatives(0.5 * mu, zero, zero, zero, zero, d_mu * psi1, 0.5 * d_mu, zero, dd_mu * psi1,
+                                    np.broadcast_to(a, (3,) + np.shape(J)))
 
 
 #: ψ1 = (Ī1 − 3)/2, the unit-modulus neo-Hookean energy the smoothed switch multiplies.

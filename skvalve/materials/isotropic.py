@@ -28,6 +28,7 @@ import numpy as np
 
 from ..kinematics import Array, determinant, identity_like, inverse
 from .base import Hyperelastic
+from .derivatives import InvariantDerivatives
 
 __all__ = ["IsotropicInvariantLaw", "Partials", "outer", "jacobian_second_derivative"]
 
@@ -101,3 +102,8 @@ class IsotropicInvariantLaw(Hyperelastic):
             + p.d_J * d2J
         )
         return S, CC
+
+    def invariant_derivatives(self, I1bar: Array, J: Array, C: Array) -> InvariantDerivatives:
+        r"""The partials of :meth:`partials` for the compiled kernel (:mod:`skvalve.fem.fused`); no :math:`I_4`."""
+        p = self.partials(I1bar, J, C)
+        return InvariantDerivatives(p.d_I, p.d_J, p.d_II, p.d_IJ, p.d_JJ)

@@ -40,6 +40,7 @@ import numpy as np
 from ..kinematics import Array, determinant, inverse
 from ._spectral import symmetric_eigen, trace_power_derivatives
 from .base import Hyperelastic, VolumetricEnergy, check_positive
+from .derivatives import PrincipalDerivatives
 from .isotropic import jacobian_second_derivative, outer
 
 __all__ = ["Ogden"]
@@ -164,3 +165,32 @@ class Ogden(Hyperelastic):
         if len(self.D) == 1:
             return Ogden(self.mu, self.alpha), VolumetricEnergy(2.0 / self.D[0], "quadratic")
         return self, None
+
+    def principal_derivatives(self, c: Array) -> PrincipalDerivatives:
+        r"""First and second derivatives of :math:`\psi` in the principal values :math:`c_a` of C.
+
+        Each term is :math:`k(K\,T - 3)`, :math:`k = 2\mu/\alpha^2`, :math:`K = (c_1c_2c_3)^{-\alpha/6}`,
+        :math:`T = \sum_a c_a^{\alpha/2}`: :math:`K_{,a} = -\tfrac{\alpha}{6}K/c_a`,
+        :math:`K_{,ab} = (\tfrac{\alpha}{6})^2 K/(c_ac_b) + \delta_{ab}\tfrac{\alpha}{6}K/c_a^2`,
+        :math:`T_{,a} = q c_a^{q-1}`, :math:`T_{,ab} = \delta_{ab} q(q-1)c_a^{q-2}` (:math:`q = \alpha/2`);
+        the volumetric :math:`U(J)`, :math:`J_{,a} = J/(2c_a)`, adds :math:`U' J/(2c_a)` and
+        :math:`U'' J^2/(4c_ac_b) + U' J/(4c_ac_b) - \delta_{ab} U' J/(2c_a^2)`.
+        """
+        c = np.asarray(c, dtype=float)
+        eye = np.eye(3).reshape((3, 3) + (1,) * (c.ndim - 1))
+        inv = 1.0 / c
+        inv_ab = inv[:, None] * inv[None, :]
+        J = np.sqrt(c[0] * c[1] * c[2])
+        _, dU, d2U = self._volumetric(J)
+        first = 0.5 * dU * J * inv
+        second = 0.25 * (d2U * J**2 + dU * J) * inv_ab - 0.5 * eye * dU * J * inv**2
+        for m, a in zip(self.mu, self.alpha, strict=True):
+            k, s, q = 2.0 * m / a**2, a / 6.0, a / 2.0
+            K = J ** (-a / 3.0)
+            T = np.sum(c**q, axis=0)
+            dK, dT = -s * K * inv, q * c ** (q - 1.0)
+            d2K = s * s * K * inv_ab + eye * s * K * inv**2
+            d2T = eye * q * (q - 1.0) * c ** (q - 2.0)
+            first = first + k * (dK * T + K * dT)
+            second = second + k * (d2K * T + dK[:, None] * dT[None, :] + dT[:, None] * dK[None, :] + K * d2T)
+        return PrincipalDerivatives(first, second)
