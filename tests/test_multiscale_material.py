@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+from _fe2_networks import affine_network
 
 from skvalve.materials.exponential_fiber import ExponentialFiber
 from skvalve.materials.neo_hookean import NeoHookean
@@ -133,20 +134,6 @@ def test_commit_moves_the_warm_start(fiber, matrix, networks):
     assert not np.array_equal(before.positions, after.positions)
     np.testing.assert_array_equal(after.F, F.transpose(3, 2, 0, 1).reshape(-1, 3, 3))
     np.testing.assert_array_equal(material.committed_fiber_stretch(1, 1).shape, (networks[1].n_fibers,))
-
-
-def affine_network(seed: int, n_fibers: int = 25) -> Network:
-    """Fibers between random points on different faces of the unit cube: no interior cross-links."""
-    rng = np.random.default_rng(seed)
-    nodes, face = [], []
-    for _ in range(2 * n_fibers):
-        f = int(rng.integers(6))
-        point = rng.uniform(-0.5, 0.5, 3)
-        point[f // 2] = 0.5 if f % 2 else -0.5
-        nodes.append(point)
-        face.append(f)
-    fibers = [[2 * k, 2 * k + 1] for k in range(n_fibers) if face[2 * k] != face[2 * k + 1]]
-    return Network(np.array(nodes), np.array(fibers), np.ones(len(nodes), bool), np.array(face))
 
 
 def test_all_boundary_networks_give_the_affine_fiber_model(fiber, matrix):
