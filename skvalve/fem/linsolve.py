@@ -1,24 +1,57 @@
-"""Sparse direct solve with the fastest available backend.
+r"""Sparse direct solves that keep the symbolic analysis across Newton iterations and load steps.
 
-Order of preference: PARDISO through ``pypardiso`` (Intel MKL, optional extra ``fast``),
-UMFPACK through ``scikit-umfpack`` when installed, then SciPy's SuperLU. All of them
-handle non-symmetric matrices (the follower-pressure load stiffness makes the tangent
-non-symmetric). A hyperelastic tangent without follower loads is symmetric (possibly
-indefinite: mixed u/p, instabilities); with ``symmetric=True`` PARDISO factorises only its
-upper triangle with symmetric Bunch–Kaufman pivoting (matrix type -2), about a third faster.
-:func:`solver_name` says which backend runs.
+A direct solve of :math:`K x = b` has three phases: the *analysis* (fill-reducing reordering and
+symbolic factorisation, which depend only on the sparsity pattern), the *numerical
+factorisation* (which depends on the values) and the *triangular solves* (per right-hand side).
+A Newton solve of a finite-element problem keeps one pattern for its whole life, so
+:class:`LinearSolver` analyses a pattern once (:meth:`~LinearSolver.analyse`), refactorises for new
+values (:meth:`~LinearSolver.factorize`, a no-op when the values are those already factorised, e.g.
+the predictor of a retried step) and solves (:meth:`~LinearSolver.solve`).
+
+Backends, fastest first:
+
+* ``"pardiso"`` — Intel MKL PARDISO through ``pypardiso`` (installed by default where MKL wheels
+  exist). Phases 11 (analysis, once per pattern), 22 (factorisation), 33 (solve). A symmetric
+  matrix (``symmetric=True``: the caller promises :math:`K = K^T`, true for a hyperelastic tangent
+  without follower loads, possibly indefinite as in mixed u/p) is factorised from its upper
+  triangle with symmetric Bunch–Kaufman pivoting (matrix type −2), about a third faster than the
+  general LU (type 11) that a non-symmetric tangent (follower pressure) needs.
+* ``"umfpack"`` — ``scikit-umfpack`` when installed.
+* ``"scipy"`` — SciPy's SuperLU, always available, much slower on large 3D problems. The column
+  permutation (COLAMD) of the first factorisation is kept and reused with ``permc_spec="NATURAL"``
+  on the permuted matrix, the SuperLU analogue of keeping the analysis.
+
+Choosing: ``solver=None`` takes the fastest available backend and warns once per process when
+that is SciPy; an explicitly requested backend that is not installed raises
+:class:`SolverUnavailableError` instead of silently falling back.
 """
 
 from __future__ import annotations
 
+import ctypes
 import importlib.util
+import sys
 import warnings
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-__all__ = ["solve", "solver_name", "available_solvers"]
+__all__ = [
+    "LinearSolver", "SolverStatistics", "SolverUnavailableError", "SlowSolverWarning", "solve", "solver_name",
+    "available_solvers",
+]
+
+_BACKENDS = (("pardiso", "pypardiso"), ("umfpack", "scikits.umfpack"))
+
+
+class SolverUnavailableError(ImportError):
+    """An explicitly requested sparse solver backend is not installed."""
+
+
+class SlowSolverWarning(UserWarning):
+    """The fast direct solver (PARDISO) is not installed; SciPy's SuperLU is used instead."""
 
 
 def _has(module: str) -> bool:
@@ -30,56 +63,307 @@ def _has(module: str) -> bool:
 
 def available_solvers() -> list[str]:
     """Backends importable here, fastest first (``"scipy"`` is always last)."""
-    names = [name for name, module in (("pardiso", "pypardiso"), ("umfpack", "scikits.umfpack")) if _has(module)]
-    return names + ["scipy"]
+    return [name for name, module in _BACKENDS if _has(module)] + ["scipy"]
+
+
+_warned_fallback = False
 
 
 def solver_name(preferred: str | None = None) -> str:
-    """The backend :func:`solve` uses: ``preferred`` if available, else the fastest one."""
+    """The backend a solve uses: ``preferred``, or the fastest available one when ``None``.
+
+    Raises ``ValueError`` for an unknown name and :class:`SolverUnavailableError` when ``preferred``
+    is not installed. Warns once per process (:class:`SlowSolverWarning`) when ``None`` resolves to
+    SciPy's SuperLU because PARDISO is missing.
+    """
+    global _warned_fallback
     names = available_solvers()
     if preferred is None:
+        if names[0] == "scipy" and not _warned_fallback:
+            _warned_fallback = True
+            warnings.warn(
+                "pypardiso (Intel MKL PARDISO) is not installed: sparse solves use SciPy's SuperLU, which is "
+                "10-20x slower on large 3D problems; `pip install pypardiso` where MKL wheels exist "
+                "(Linux/Windows x86-64)", SlowSolverWarning, stacklevel=2,
+            )
         return names[0]
     if preferred not in ("pardiso", "umfpack", "scipy"):
         raise ValueError(f"unknown sparse solver {preferred!r}; choose pardiso, umfpack or scipy")
-    return preferred if preferred in names else names[0]
+    if preferred not in names:
+        module = dict(_BACKENDS)[preferred]
+        raise SolverUnavailableError(
+            f"sparse solver {preferred!r} was requested but its package {module!r} is not installed "
+            f"(available: {', '.join(names)}); install it or pass solver=None for the fastest available one"
+        )
+    return preferred
 
 
-_PARDISO: dict[int, object] = {}
+@dataclass
+class SolverStatistics:
+    """How often each phase ran (the analysis should run once per pattern)."""
+
+    analyses: int = 0
+    factorizations: int = 0
+    reused_factorizations: int = 0
+    solves: int = 0
 
 
-def _pardiso(mtype: int):
-    if mtype not in _PARDISO:
-        import pypardiso
+class _Pardiso:
+    """Thin ctypes driver of MKL PARDISO (zero-based CSR, phases called explicitly)."""
 
-        _PARDISO[mtype] = pypardiso.PyPardisoSolver(mtype=mtype)
-    return _PARDISO[mtype]
+    def __init__(self, mtype: int) -> None:
+        import pypardiso  # optional dependency, loaded only when this backend is used
+
+        self._library = pypardiso.PyPardisoSolver(mtype=mtype)  # locates and loads mkl_rt
+        self._pardiso = self._library._mkl_pardiso
+        self.mtype = mtype
+        self.pt = np.zeros(64, dtype=np.int64)
+        self.iparm = np.zeros(64, dtype=np.int32)
+        self.iparm[0] = 1  # iparm given explicitly (entries left 0 take MKL defaults)
+        self.iparm[1] = 2  # nested dissection (METIS) reordering
+        self.iparm[7] = 2  # up to two iterative refinement steps
+        self.iparm[9] = 13 if mtype == 11 else 8  # pivot perturbation 1e-13 / 1e-8 (MKL defaults)
+        self.iparm[10] = 1 if mtype == 11 else 0  # scaling (non-symmetric only)
+        self.iparm[12] = 1 if mtype == 11 else 0  # weighted matching (non-symmetric only)
+        self.iparm[34] = 1  # zero-based indexing
+        self.n = 0
+        self.active = False
+
+    def call(self, phase: int, data: np.ndarray, indptr: np.ndarray, indices: np.ndarray,
+             rhs: np.ndarray | None = None) -> np.ndarray | None:
+        error = ctypes.c_int32(0)
+        i32 = ctypes.POINTER(ctypes.c_int32)
+        f64 = ctypes.POINTER(ctypes.c_double)
+        nrhs = 1 if rhs is None or rhs.ndim == 1 else rhs.shape[1]
+        b = np.zeros(1) if rhs is None else np.asfortranarray(rhs, dtype=float)
+        x = np.zeros_like(b)
+        perm = np.zeros(1, dtype=np.int32)
+        self._pardiso(
+            self.pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)), ctypes.byref(ctypes.c_int32(1)),
+            ctypes.byref(ctypes.c_int32(1)), ctypes.byref(ctypes.c_int32(self.mtype)),
+            ctypes.byref(ctypes.c_int32(phase)), ctypes.byref(ctypes.c_int32(self.n)), data.ctypes.data_as(f64),
+            indptr.ctypes.data_as(i32), indices.ctypes.data_as(i32), perm.ctypes.data_as(i32),
+            ctypes.byref(ctypes.c_int32(nrhs)), self.iparm.ctypes.data_as(i32), ctypes.byref(ctypes.c_int32(0)),
+            b.ctypes.data_as(f64), x.ctypes.data_as(f64), ctypes.byref(error),
+        )
+        if phase > 0:
+            self.active = True
+        if error.value != 0:
+            raise np.linalg.LinAlgError(f"PARDISO phase {phase} failed with error {error.value}")
+        return np.ascontiguousarray(x) if rhs is not None else None
+
+    def release(self) -> None:
+        if self.active:
+            dummy_i = np.zeros(1, dtype=np.int32)
+            self.call(-1, np.zeros(1), dummy_i, dummy_i)
+            self.active = False
+
+    def __del__(self) -> None:  # pragma: no cover - depends on garbage collection
+        if not sys.is_finalizing():
+            self.release()
+
+
+class LinearSolver:
+    """Direct solver of ``K x = b`` for a fixed sparsity pattern and changing values.
+
+    Parameters
+    ----------
+    solver : ``"pardiso"``, ``"umfpack"``, ``"scipy"`` or ``None`` (fastest available; see
+        :func:`solver_name`).
+    symmetric : promise that every matrix factorised is symmetric; only its upper triangle is
+        then used (PARDISO symmetric indefinite, matrix type −2).
+
+    Use::
+
+        solver = LinearSolver(None, symmetric=True)
+        solver.analyse(K)              # once per sparsity pattern (any values)
+        solver.factorize(K.data)       # values in the order of K.indices (or a CSR matrix)
+        x = solver.solve(rhs)
+    """
+
+    def __init__(self, solver: str | None = None, symmetric: bool = False) -> None:
+        self.name = solver_name(solver)
+        self.symmetric = bool(symmetric)
+        self.statistics = SolverStatistics()
+        self._indptr: np.ndarray | None = None
+        self._indices: np.ndarray | None = None
+        self._factor = None
+        self._factorized_values: np.ndarray | None = None
+        self._pardiso: _Pardiso | None = None
+        self._permutation: np.ndarray | None = None
+
+    # ------------------------------------------------------------------ pattern
+    def matches(self, indptr: np.ndarray, indices: np.ndarray) -> bool:
+        """True when ``(indptr, indices)`` is the pattern analysed last."""
+        return (self._indptr is not None and indptr.shape == self._indptr.shape
+                and indices.shape == self._indices.shape and np.array_equal(indptr, self._indptr)
+                and np.array_equal(indices, self._indices))
+
+    def analyse(self, pattern: sp.spmatrix | tuple[np.ndarray, np.ndarray]) -> LinearSolver:
+        """Take the sparsity pattern (a CSR matrix with sorted indices, or ``(indptr, indices)``).
+
+        The reordering itself runs with the first :meth:`factorize` (PARDISO's scaling and matching
+        for non-symmetric matrices need values) and then never again for this pattern.
+        """
+        if sp.issparse(pattern):
+            csr = sp.csr_matrix(pattern)
+            csr.sort_indices()
+            indptr, indices = csr.indptr, csr.indices
+        else:
+            indptr, indices = pattern
+        indptr = np.asarray(indptr, dtype=np.int64)
+        indices = np.asarray(indices, dtype=np.int64)
+        n = indptr.size - 1
+        if n < 1 or indices.size != indptr[-1] or (indices.size and (indices.min() < 0 or indices.max() >= n)):
+            raise ValueError("pattern must be a square CSR pattern (indptr of n+1 entries, indices in 0..n-1)")
+        if self.matches(indptr, indices):
+            return self
+        self._release()
+        self._indptr, self._indices, self.n = indptr.copy(), indices.copy(), n
+        rows = np.repeat(np.arange(n), np.diff(indptr))
+        if np.any(np.diff(indices)[np.diff(rows) == 0] <= 0):
+            raise ValueError("pattern indices must be sorted and unique within each row")
+        if self.symmetric:
+            self._upper_triangle(rows, indices)
+        self._indptr32, self._indices32 = indptr.astype(np.int32), indices.astype(np.int32)
+        self._rows = rows
+        return self
+
+    def _upper_triangle(self, rows: np.ndarray, indices: np.ndarray) -> None:
+        """Upper-triangle pattern with every diagonal entry present (PARDISO needs them) and its sources."""
+        n = self.n
+        upper = np.flatnonzero(indices >= rows)
+        missing = np.setdiff1d(np.arange(n), rows[upper][indices[upper] == rows[upper]])
+        up_rows = np.concatenate([rows[upper], missing])
+        up_cols = np.concatenate([indices[upper], missing])
+        source = np.concatenate([upper, np.full(missing.size, -1)])
+        order = np.lexsort((up_cols, up_rows))
+        self._upper_source = np.maximum(source[order], 0)
+        self._upper_inserted = source[order] < 0
+        self._upper_indptr = np.concatenate([[0], np.cumsum(np.bincount(up_rows, minlength=n))]).astype(np.int32)
+        self._upper_indices = up_cols[order].astype(np.int32)
+
+    # ------------------------------------------------------------ factorisation
+    def factorize(self, values: np.ndarray | sp.spmatrix) -> LinearSolver:
+        """Numerical factorisation for ``values`` on the analysed pattern (skipped if unchanged)."""
+        if self._indptr is None:
+            raise RuntimeError("LinearSolver.factorize before analyse(pattern)")
+        if sp.issparse(values):
+            csr = sp.csr_matrix(values)
+            csr.sort_indices()
+            if not self.matches(np.asarray(csr.indptr, np.int64), np.asarray(csr.indices, np.int64)):
+                raise ValueError("matrix pattern differs from the analysed one; call analyse() first")
+            values = csr.data
+        values = np.asarray(values, dtype=float)
+        if values.shape != self._indices.shape:
+            raise ValueError(f"values must have {self._indices.size} entries (the pattern); got {values.shape}")
+        if self._factorized_values is not None and np.array_equal(values, self._factorized_values):
+            self.statistics.reused_factorizations += 1
+            return self
+        if not np.all(np.isfinite(values)):
+            raise np.linalg.LinAlgError("tangent matrix has non-finite entries")
+        self._factorized_values = None
+        getattr(self, f"_factorize_{self.name}")(values)
+        self._factorized_values = values.copy()
+        self.statistics.factorizations += 1
+        return self
+
+    def _factorize_pardiso(self, values: np.ndarray) -> None:
+        first = self._pardiso is None
+        if first:
+            self._pardiso = _Pardiso(-2 if self.symmetric else 11)
+            self._pardiso.n = self.n
+        if self.symmetric:
+            self._data = values[self._upper_source]
+            self._data[self._upper_inserted] = 0.0
+        else:
+            self._data = values
+        # phase 12 = analysis + factorisation (first time), 22 = factorisation with the kept analysis
+        try:
+            self._pardiso.call(12 if first else 22, self._data, *self._pardiso_pattern())
+        except np.linalg.LinAlgError:
+            if first:
+                self._release()
+            raise
+        self.statistics.analyses += first
+
+    def _pardiso_pattern(self) -> tuple[np.ndarray, np.ndarray]:
+        if self.symmetric:
+            return self._upper_indptr, self._upper_indices
+        return self._indptr32, self._indices32
+
+    def _matrix(self, values: np.ndarray) -> sp.csc_matrix:
+        return sp.csr_matrix((values, self._indices, self._indptr), shape=(self.n, self.n)).tocsc()
+
+    def _factorize_scipy(self, values: np.ndarray) -> None:
+        A = self._matrix(values)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", spla.MatrixRankWarning)
+            try:
+                if self._permutation is None:
+                    self._factor = spla.splu(A, permc_spec="COLAMD")
+                    self._permutation = self._factor.perm_c.copy()
+                    self._permuted = False
+                    self.statistics.analyses += 1
+                else:  # the kept column ordering: factorise A[:, perm] in its natural order
+                    self._factor = spla.splu(A[:, self._permutation], permc_spec="NATURAL")
+                    self._permuted = True
+            except (RuntimeError, spla.MatrixRankWarning) as err:
+                raise np.linalg.LinAlgError(f"singular tangent matrix ({err})") from err
+
+    def _factorize_umfpack(self, values: np.ndarray) -> None:  # pragma: no cover - optional package
+        self._factor = self._matrix(values)
+        self.statistics.analyses += self.statistics.factorizations == 0
+
+    # --------------------------------------------------------------------- solve
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """``x`` with ``K x = rhs`` for the last factorised values; ``LinAlgError`` if not finite."""
+        if self._factorized_values is None:
+            raise RuntimeError("LinearSolver.solve before factorize(values)")
+        rhs = np.asarray(rhs, dtype=float)
+        if rhs.shape[0] != self.n:
+            raise ValueError(f"rhs must have {self.n} rows; got {rhs.shape}")
+        if self.name == "pardiso":
+            x = self._pardiso.call(33, self._data, *self._pardiso_pattern(), rhs=rhs)
+        elif self.name == "scipy":
+            x = self._factor.solve(rhs)
+            if self._permuted:  # A[:, perm] y = rhs  =>  x[perm] = y
+                y, x = x, np.empty_like(x)
+                x[self._permutation] = y
+        else:  # pragma: no cover - optional package
+            x = spla.spsolve(self._factor, rhs, use_umfpack=True)
+        self.statistics.solves += 1
+        if not np.all(np.isfinite(x)):
+            raise np.linalg.LinAlgError("sparse solve returned non-finite values (singular tangent?)")
+        return x
+
+    def _release(self) -> None:
+        if self._pardiso is not None:
+            self._pardiso.release()
+        self._pardiso = None
+        self._factor = None
+        self._factorized_values = None
+        self._permutation = None
+
+
+_SOLVERS: dict[tuple[str, bool], LinearSolver] = {}
 
 
 def solve(matrix: sp.spmatrix, rhs: np.ndarray, solver: str | None = None, symmetric: bool = False) -> np.ndarray:
     """Solve ``matrix @ x = rhs`` (square) and return ``x``.
 
-    ``symmetric=True`` promises ``matrix == matrix.T`` (only the upper triangle is then used by
-    PARDISO). Raises ``np.linalg.LinAlgError`` when the result is not finite (singular system).
+    Keeps one :class:`LinearSolver` per (backend, symmetric) in this process: consecutive calls
+    with the same sparsity pattern reuse its analysis, with the same values its factorisation.
+    ``symmetric=True`` promises ``matrix == matrix.T``. Raises ``np.linalg.LinAlgError`` when the
+    system is singular or the result is not finite.
     """
-    matrix = sp.csr_matrix(matrix)
     name = solver_name(solver)
-    rhs = np.asarray(rhs, dtype=float)
-    if name == "pardiso":
-        if symmetric:
-            upper = sp.triu(matrix, format="csr")
-            upper.sort_indices()
-            x = _pardiso(-2).solve(upper, rhs)
-        else:
-            x = _pardiso(11).solve(matrix, rhs)
-    elif name == "umfpack":  # pragma: no cover - depends on optional package
-        x = spla.spsolve(matrix.tocsc(), rhs, use_umfpack=True)
-    else:
-        with warnings.catch_warnings():
-            warnings.simplefilter("error", spla.MatrixRankWarning)
-            try:
-                x = spla.spsolve(matrix.tocsc(), rhs, permc_spec="COLAMD", use_umfpack=False)
-            except spla.MatrixRankWarning as err:
-                raise np.linalg.LinAlgError(f"singular tangent matrix ({err})") from err
-    if not np.all(np.isfinite(x)):
-        raise np.linalg.LinAlgError("sparse solve returned non-finite values (singular tangent?)")
-    return x
+    csr = sp.csr_matrix(matrix)
+    csr.sort_indices()
+    key = (name, bool(symmetric))
+    if key not in _SOLVERS:
+        _SOLVERS[key] = LinearSolver(name, symmetric)
+    linear = _SOLVERS[key]
+    linear.analyse((csr.indptr, csr.indices))
+    linear.factorize(csr.data)
+    return linear.solve(rhs)
