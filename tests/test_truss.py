@@ -1,0 +1,145 @@
+"""Trusses and uniaxial laws: Ogden in uniaxial stress against the 3D law, bar tangents against finite
+differences, a single chord against its closed form, a chord tied to a block."""
+
+import numpy as np
+import pytest
+import skfem
+
+from skvalve.fem import NodalForce, Problem, Solid, Space, solve
+from skvalve.fem.truss import LawAssignment, Truss, bar_response
+from skvalve.materials import NeoHookean, Ogden
+from skvalve.materials.uniaxial import LinearUniaxial, OgdenUniaxial, TensionOnly
+
+# chordae-like parameters (three terms, one of them with a tiny exponent), MPa
+CHORD = OgdenUniaxial(mu=(4.2, 7.6, 1e-4), alpha=(50.4, 15.4, 1e-4))
+
+
+@pytest.mark.parametrize("stretch", [0.8, 1.0, 1.03, 1.2])
+def test_ogden_uniaxial_matches_the_3d_incompressible_law(stretch):
+    """P = (sigma_11 - sigma_22)/lambda of the 3D law at F = diag(l, l^-1/2, l^-1/2) (lateral stress free)."""
+    mu, alpha = (0.6, 0.3), (3.0, -2.0)
+    law3d = Ogden(mu=mu, alpha=alpha)
+    F = np.diag([stretch, stretch**-0.5, stretch**-0.5])
+    sigma = law3d.cauchy(F)
+    expected = (sigma[0, 0] - sigma[1, 1]) / stretch
+    P, _ = OgdenUniaxial(mu, alpha).nominal_stress(np.array([stretch]))
+    assert P[0] == pytest.approx(expected, rel=1e-10, abs=1e-12)
+
+
+def test_ogden_uniaxial_slope_and_small_exponent():
+    lam = np.linspace(0.7, 1.3, 13)
+    P, dP = CHORD.nominal_stress(lam)
+    h = 1e-6
+    fd = (CHORD.nominal_stress(lam + h)[0] - CHORD.nominal_stress(lam - h)[0]) / (2 * h)
+    assert np.allclose(dP, fd, rtol=1e-7)
+    assert dP[6] == pytest.approx(CHORD.young_modulus, rel=1e-12)
+    # one term with alpha -> 0: P -> 2 mu (3/2 L + 3/8 alpha L^2) / lambda, L = ln(lambda) (Taylor series)
+    tiny = OgdenUniaxial(mu=(43.0,), alpha=(1e-4,))
+    L = np.log(lam)
+    series = 2 * 43.0 * (1.5 * L + 0.375 * 1e-4 * L**2 + 0.1875 * 1e-8 * L**3) / lam
+    assert np.allclose(tiny.nominal_stress(lam)[0], series, rtol=1e-10, atol=1e-14)
+
+
+def test_tension_only_is_slack_below_unit_stretch():
+    cable = TensionOnly(CHORD, slack_fraction=1e-4)
+    lam = np.array([0.5, 0.999, 1.0, 1.1])
+    P, dP = cable.nominal_stress(lam)
+    assert cable.slack_stiffness == pytest.approx(1e-4 * CHORD.young_modulus)
+    assert np.allclose(P[:2], cable.slack_stiffness * (lam[:2] - 1.0))
+    assert np.allclose(dP[:2], cable.slack_stiffness)
+    assert np.allclose(P[2:], CHORD.nominal_stress(lam[2:])[0])
+    with pytest.raises(ValueError, match="slack_fraction"):
+        TensionOnly(CHORD, slack_fraction=0.0)
+    with pytest.raises(ValueError, match="stretch"):
+        cable.nominal_stress(np.array([-1.0]))
+
+
+@pytest.mark.parametrize("law", [CHORD, TensionOnly(CHORD), LinearUniaxial(3.0)])
+def test_bar_tangent_matches_central_differences(law):
+    rng = np.random.default_rng(3)
+    n = 6
+    x_a, x_b = rng.standard_normal((n, 3)), rng.standard_normal((n, 3))
+    length = np.linalg.norm(x_b - x_a, axis=1)
+    rest = length * rng.uniform(0.85, 1.1, n)  # some slack, some taut
+    area = rng.uniform(0.2, 0.5, n)
+    laws = LawAssignment(law, None, n)
+    state = bar_response(x_a, x_b, rest, area, laws)
+    x = np.hstack([x_a, x_b])
+    h = 1e-7
+    for m in range(6):
+        plus, minus = x.copy(), x.copy()
+        plus[:, m] += h
+        minus[:, m] -= h
+        fp = bar_response(plus[:, :3], plus[:, 3:], rest, area, laws, tangent=False).forces
+        fm = bar_response(minus[:, :3], minus[:, 3:], rest, area, laws, tangent=False).forces
+        fd = (fp - fm) / (2 * h)
+        scale = np.abs(state.matrices).max()
+        assert np.abs(state.matrices[:, :, m] - fd).max() < 1e-6 * scale
+    assert np.allclose(state.matrices, state.matrices.transpose(0, 2, 1))
+    # geometric stiffness: transverse stiffness N / l
+    n_hat = (x_b - x_a) / length[:, None]
+    t_hat = np.cross(n_hat, [0.0, 0.0, 1.0])
+    t_hat /= np.linalg.norm(t_hat, axis=1, keepdims=True)
+    transverse = np.einsum("ei,eij,ej->e", t_hat, state.matrices[:, 3:, 3:], t_hat)
+    assert np.allclose(transverse, state.axial_force / length)
+
+
+def _single_chord_space(L: float) -> Space:
+    """A one-element hex mesh used only for its nodes 0 = (0,0,0) and 1 = (L,0,0)."""
+    mesh = skfem.MeshHex().scaled([L, L, L])
+    return Space(mesh)
+
+
+def test_single_chord_against_closed_form():
+    """Chord along x, one end fixed, the other pulled by a force F: A P(lambda) = F, lateral stress free."""
+    L, area, force = 2.0, 0.33, 1.5
+    space = _single_chord_space(L)
+    X = space.dof_coordinates
+    a = int(np.flatnonzero(np.all(np.isclose(X, 0.0), axis=0))[0])
+    b = int(np.flatnonzero(np.isclose(X[0], L) & np.isclose(X[1], 0) & np.isclose(X[2], 0))[0])
+    problem = Problem(space, [Truss(space, [[a, b]], area, CHORD)])
+    others = np.setdiff1d(np.arange(space.n_scalar), [b])
+    problem.add_dirichlet(nodes=others, value=0.0)
+    problem.add_term(NodalForce(space, np.array([b]), [force, 0.0, 0.0], ramp=True))
+    result = solve(problem, steps=4, progress=False, rtol=1e-11)
+    stretch = 1.0 + result.u()[3 * b] / L
+    # closed form A P(lambda) = F, inverted by bisection on the 3-term formula written out
+    lo, hi = 1.0, 1.5
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        terms = zip(CHORD.mu, CHORD.alpha, strict=True)
+        value = sum(2 * m / al * (mid ** (al - 1) - mid ** (-al / 2 - 1)) for m, al in terms)
+        lo, hi = (mid, hi) if area * value < force else (lo, mid)
+    assert stretch == pytest.approx(lo, rel=1e-9)
+    assert np.allclose(result.u()[3 * b + 1: 3 * b + 3], 0.0, atol=1e-12)
+
+
+def test_chord_tied_to_a_block():
+    """A chord pulls the free face of a block: chord force = block reaction, and the chord force equals
+    A P(lambda) at the stretch the solve reached (two laws meeting at shared nodes)."""
+    mesh = skfem.MeshHex().refined(1)
+    # a node outside the block, on the chord axis: add it as an extra hex-less node is impossible, so
+    # tie the chord between the centre of the face x = 1 and a node of the face x = 0 of a second block
+    mesh2 = skfem.MeshHex().refined(1).translated([3.0, 0.0, 0.0])
+    p = np.hstack([mesh.p, mesh2.p])
+    t = np.hstack([mesh.t, mesh2.t + mesh.p.shape[1]])
+    both = skfem.MeshHex(p, t)
+    solid = Solid(both, NeoHookean(1.0, 5.0))
+    X = solid.space.dof_coordinates
+    face = np.flatnonzero(np.isclose(X[0], 1.0) & np.isclose(X[1], 0.5) & np.isclose(X[2], 0.5))[0]
+    anchor = np.flatnonzero(np.isclose(X[0], 3.0) & np.isclose(X[1], 0.5) & np.isclose(X[2], 0.5))[0]
+    area, rest = 0.2, 1.9  # pre-stretched: rest length below the 2.0 gap
+    chord = solid.add_term(Truss(solid.space, [[face, anchor]], area, LinearUniaxial(10.0), rest_length=[rest]))
+    solid.add_dirichlet(lambda X: X[0] < 1e-9, 0.0)
+    second = np.flatnonzero(X[0] > 2.5)
+    solid.add_dirichlet(nodes=second, value=0.0)
+    result = solid.solve(steps=1, progress=False, rtol=1e-11)
+    u = result.u()
+    state = chord.response(u)
+    # chord force from the law at the reached stretch
+    gap = np.linalg.norm(X[:, anchor] - (X[:, face] + u[3 * face: 3 * face + 3]))
+    assert state.axial_force[0] == pytest.approx(area * 10.0 * (gap / rest - 1.0), rel=1e-10)
+    # the fixed face x = 0 of the block carries the chord force (equilibrium of the first block)
+    reaction = result.reaction(lambda X: X[0] < 1e-9)
+    assert reaction[0] == pytest.approx(-state.axial_force[0], rel=1e-8)
+    assert 0 < u[3 * face] < 0.1
