@@ -145,3 +145,29 @@ def test_resume_from_a_converged_state_gives_the_same_result():
 def test_problem_rejects_objects_that_are_not_terms():
     with pytest.raises(TypeError, match="assemble"):
         Problem(Space(box(1)), [object()])
+
+
+def test_checkpoint_resume_reproduces_an_uninterrupted_run(tmp_path):
+    """Stop after step 2 of 4 (a callback raising, as an interrupt would), resume from disk, compare."""
+    from skvalve.io.checkpoint import Checkpoint, resume
+
+    def build():
+        return Solid(box(2), LAW).add_dirichlet("left", 0.0).add_dirichlet("right", 0.3, components=[0])
+
+    full = build().solve(steps=4, progress=False, rtol=1e-12)
+
+    def interrupt(event):
+        if event.step == 2:
+            raise RuntimeError("interrupted")
+
+    with pytest.raises(OutputError):
+        build().solve(steps=4, progress=False, rtol=1e-12, callbacks=[Checkpoint(tmp_path), interrupt])
+    problem = build()
+    t0, u0 = resume(problem, tmp_path)
+    assert t0 == 0.5
+    resumed = problem.solve(steps=4, progress=False, rtol=1e-12, t0=t0, u0=u0, callbacks=[Checkpoint(tmp_path)])
+    assert np.abs(resumed.u() - full.u()).max() <= 1e-12 * np.abs(full.u()).max()
+    assert sorted(p.name for p in tmp_path.glob("step_*.npz")) == [f"step_0000{k}.npz" for k in (1, 2, 3, 4)]
+    (tmp_path / "step_00004.npz").write_bytes(b"truncated")
+    with pytest.raises(ValueError, match="step_00004.npz is damaged"):
+        resume(build(), tmp_path)

@@ -267,6 +267,26 @@ class Problem:
         for term in self.terms:
             term.rewind()
 
+    def state(self) -> dict[str, np.ndarray]:
+        """Committed state of every term that has one (``term.state()``), keyed ``"<k>/<name>"``."""
+        out = {}
+        for k, term in enumerate(self.terms):
+            getter = getattr(term, "state", None)
+            if getter is not None:
+                for name, array in getter().items():
+                    out[f"{k}/{name}"] = np.asarray(array)
+        return out
+
+    def restore(self, state: dict[str, np.ndarray]) -> None:
+        """Give each term back what :meth:`state` took from it (``term.restore(arrays)``), then commit."""
+        for k, term in enumerate(self.terms):
+            restore = getattr(term, "restore", None)
+            mine = {key.split("/", 1)[1]: value for key, value in state.items() if key.split("/", 1)[0] == str(k)}
+            if restore is not None:
+                restore(mine)
+            elif mine:
+                raise ValueError(f"term {k} ({type(term).__name__}) has saved state but no restore()")
+
     @property
     def materials(self):
         """The material regions of the (single) solid term, for stress output."""

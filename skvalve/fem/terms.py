@@ -86,3 +86,6 @@ class Term:
 
     def rewind(self) -> None:
         """Return to the last committed state (after a failed attempt)."""
+
+    # Optional, for checkpoints (skvalve.io.checkpoint): ``state() -> dict[str, ndarray]`` returns the
+    # committed state and ``restore(arrays)`` sets it (and commits). Terms without state omit both.
