@@ -96,3 +96,23 @@ class HyperelasticTerm(Term):
             rewind = getattr(region.material, "rewind", None)
             if rewind is not None:
                 rewind()
+
+    def state(self) -> dict[str, np.ndarray]:
+        """Committed state of the regions' materials that have one (``material.state()``)."""
+        out = {}
+        for k, region in enumerate(self.materials.regions):
+            getter = getattr(region.material, "state", None)
+            if getter is not None:
+                out.update({f"region{k}.{name}": value for name, value in getter().items()})
+        return out
+
+    def restore(self, arrays: dict[str, np.ndarray]) -> None:
+        """Hand each region's material its arrays from :meth:`state`."""
+        for k, region in enumerate(self.materials.regions):
+            prefix = f"region{k}."
+            mine = {key[len(prefix):]: value for key, value in arrays.items() if key.startswith(prefix)}
+            restore = getattr(region.material, "restore", None)
+            if restore is not None:
+                restore(mine)
+            elif mine:
+                raise ValueError(f"material of region {k} has saved state but no restore()")
