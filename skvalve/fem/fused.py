@@ -111,10 +111,12 @@ def _inverse_transpose(F, H):
 
 
 @njit(cache=True)
-def _invariant_point(F, H, J, D, a, has_direction, S, A, tangent):
-    """S and A at one point of a law psi(I1bar, J, I4); D = (d1, dJ, d11, d1J, dJJ, d4, d14, dJ4, d44)."""
+def _invariant_point(F, H, J, D, a, has_direction, S, A, tangent, G, M, B):
+    """S and A at one point of a law psi(I1bar, J, I4); D = (d1, dJ, d11, d1J, dJJ, d4, d14, dJ4, d44).
+
+    G (3,3), M (3,3), B (3,3,3) are scratch arrays: C^{-1} = H^T H, the dyad coefficients and the dyads.
+    """
     d1, dJ, d11, d1J, dJJ, d4, d14, dJ4, d44 = D[0], D[1], D[2], D[3], D[4], D[5], D[6], D[7], D[8]
-    G = np.empty((3, 3))  # C^{-1} = F^{-1} F^{-T} = H^T H
     I1 = 0.0
     for I in range(3):
         for K in range(3):
@@ -137,14 +139,13 @@ def _invariant_point(F, H, J, D, a, has_direction, S, A, tangent):
         return
     # F E1 = alpha1 F + beta1 H, F EJ = betaJ H, F E4 = (F a) x a
     alpha1, beta1, betaJ = Jm23, -Jm23 * I1 / 3.0, 0.5 * J
-    M = np.zeros((3, 3))  # coefficients of b_m (x) b_n, b = (F, H, (Fa) x a)
+    M[:] = 0.0  # coefficients of b_m (x) b_n, b = (F, H, (Fa) x a)
     M[0, 0] = d11 * alpha1 * alpha1
     M[0, 1] = d11 * alpha1 * beta1 + d1J * alpha1 * betaJ - d1 * Jm23 / 3.0
     M[1, 1] = (d11 * beta1 * beta1 + 2.0 * d1J * beta1 * betaJ + dJJ * betaJ * betaJ + d1 * I1bar / 9.0
                + dJ * J / 4.0)
     gamma = d1 * I1bar / 3.0 - dJ * J / 2.0
     nb = 2
-    B = np.empty((3, 3, 3))
     for i in range(3):
         for j in range(3):
             B[0, i, j] = F[i, j]
@@ -184,10 +185,11 @@ def _invariant_point(F, H, J, D, a, has_direction, S, A, tangent):
 
 
 @njit(cache=True)
-def _principal_point(F, D, V, S, A, tangent):
-    """S and A at one point of a law psi(c1, c2, c3); D = (psi_a (3), psi_ab (9)), V[:, a] = N_a."""
-    c = np.empty(3)
-    n = np.empty((3, 3))  # n[:, a] = F N_a, |n_a|^2 = c_a
+def _principal_point(F, D, V, S, A, tangent, c, n, theta):
+    """S and A at one point of a law psi(c1, c2, c3); D = (psi_a (3), psi_ab (9)), V[:, a] = N_a.
+
+    c (3), n (3,3), theta (3,3) are scratch arrays: eigenvalues, n[:, a] = F N_a, divided differences.
+    """
     for a in range(3):
         s = 0.0
         for i in range(3):
@@ -203,8 +205,8 @@ def _principal_point(F, D, V, S, A, tangent):
             S[I, K] = 2.0 * s
     if not tangent:
         return
-    theta = np.zeros((3, 3))
     for a in range(3):
+        theta[a, a] = 0.0
         for b in range(3):
             if a != b:
                 if abs(c[a] - c[b]) <= 1e-8 * (c[a] + c[b]):
@@ -244,6 +246,10 @@ def _fused_kernel(kind, F, D, aux, has_direction, dN, dx, tangent, pressure, Np,
         Dq = np.empty(D.shape[0])
         Vq = np.empty((3, 3))
         aq = np.zeros(3)
+        G3 = np.empty((3, 3))
+        M3 = np.empty((3, 3))
+        B3 = np.empty((3, 3, 3))
+        c3 = np.empty(3)
         for q in range(nqp):
             for i in range(3):
                 for j in range(3):
@@ -255,12 +261,12 @@ def _fused_kernel(kind, F, D, aux, has_direction, dN, dx, tangent, pressure, Np,
                 if has_direction:
                     for i in range(3):
                         aq[i] = aux[i, 0, q, e]
-                _invariant_point(Fq, H, J, Dq, aq, has_direction, S, A, tangent)
+                _invariant_point(Fq, H, J, Dq, aq, has_direction, S, A, tangent, G3, M3, B3)
             else:
                 for i in range(3):
                     for j in range(3):
                         Vq[i, j] = aux[i, j, q, e]
-                _principal_point(Fq, Dq, Vq, S, A, tangent)
+                _principal_point(Fq, Dq, Vq, S, A, tangent, c3, M3, G3)
             for i in range(3):
                 for j in range(3):
                     s = 0.0
