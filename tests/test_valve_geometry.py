@@ -1,0 +1,180 @@
+"""Valve geometry measures against closed forms, and on the Texas TriValve 1.0 diseased input.
+
+Closed forms: inscribed n-gon areas of a circle and an ellipse (n/2 R^2 sin(2 pi/n), n/2 a b sin(2 pi/n)),
+rigidly moved and saddle-warped loops, planar quads in a tilted plane (shoelace in the plane), the
+faceted cylinder (n rectangles of chord width 2 R sin(theta/2n)), the bilinear hyperbolic-paraboloid
+patch z = x y (area by independent adaptive quadrature), and offset cylinders (radius R + d).
+"""
+
+import logging
+
+import numpy as np
+import pytest
+from scipy import integrate
+from scipy.spatial.transform import Rotation
+
+from skvalve.io.abaqus import read_model, trivalve_inputs
+from skvalve.valve.geometry import (
+    annulus_nodes,
+    boundary_loops,
+    centre_region,
+    face_areas,
+    leaflet_surfaces,
+    loop_area,
+    offset_points,
+    orifice_area,
+    surface_area,
+    valve_areas,
+)
+
+ROTATION = Rotation.from_rotvec([0.3, -1.1, 0.7]).as_matrix()
+SHIFT = np.array([4.0, -2.0, 9.0])
+
+
+def _ellipse(a, b, n, warp=0.0):
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    return np.column_stack([a * np.cos(t), b * np.sin(t), warp * np.cos(2 * t)])
+
+
+def _ring(radii, n):
+    """Quad mesh between concentric circles: points and faces."""
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    points = np.concatenate([np.column_stack([r * np.cos(t), r * np.sin(t), np.zeros(n)]) for r in radii])
+    faces = [[i * n + j, i * n + (j + 1) % n, (i + 1) * n + (j + 1) % n, (i + 1) * n + j]
+             for i in range(len(radii) - 1) for j in range(n)]
+    return points, np.array(faces)
+
+
+def _cylinder(radius, angle, height, n, rows=3, closed=False):
+    count = n if closed else n + 1
+    t = np.linspace(0, angle, count, endpoint=not closed)
+    z = np.linspace(0, height, rows + 1)
+    points = np.array([[radius * np.cos(a), radius * np.sin(a), h] for h in z for a in t])
+    faces = [[r * count + j, r * count + (j + 1) % count, (r + 1) * count + (j + 1) % count, (r + 1) * count + j]
+             for r in range(rows) for j in range(n)]
+    return points, np.array(faces)
+
+
+@pytest.mark.parametrize("n", [8, 50, 400])
+def test_circle_and_ellipse_loops(n):
+    exact = 0.5 * n * np.sin(2 * np.pi / n)
+    assert loop_area(_ellipse(3.0, 3.0, n)) == pytest.approx(9.0 * exact, rel=1e-12)
+    assert loop_area(_ellipse(5.0, 2.0, n)) == pytest.approx(10.0 * exact, rel=1e-12)
+
+
+def test_loop_area_converges_to_pi_r_squared_at_second_order():
+    errors = [abs(loop_area(_ellipse(2.0, 2.0, n)) - 4 * np.pi) for n in (32, 64, 128)]
+    orders = np.log2(np.array(errors[:-1]) / errors[1:])
+    assert orders == pytest.approx([2.0, 2.0], abs=0.01)
+
+
+def test_loop_area_is_that_of_the_best_fit_plane():
+    loop = _ellipse(5.0, 2.0, 60)
+    moved = loop @ ROTATION.T + SHIFT
+    assert loop_area(moved) == pytest.approx(loop_area(loop), rel=1e-12)
+    # a saddle (z = h cos 2t) has best-fit plane z = 0: its orifice is the flat ellipse's
+    saddle = _ellipse(5.0, 2.0, 60, warp=1.5) @ ROTATION.T + SHIFT
+    assert loop_area(saddle) == pytest.approx(loop_area(loop), rel=1e-12)
+    order = np.random.default_rng(0).permutation(60)
+    assert loop_area(moved[order], np.argsort(order)) == pytest.approx(loop_area(loop), rel=1e-12)
+
+
+def test_planar_quads_in_a_tilted_plane():
+    rng = np.random.default_rng(1)
+    quads = []
+    while len(quads) < 20:  # convex quads: corners on an ellipse, no gap of half a turn or more
+        angles = np.sort(rng.uniform(0, 2 * np.pi, 4))
+        if np.max(np.diff(np.append(angles, angles[0] + 2 * np.pi))) >= 0.9 * np.pi:
+            continue
+        a, b = rng.uniform(0.5, 2.0, 2)
+        quads.append(np.column_stack([a * np.cos(angles), b * np.sin(angles), np.zeros(4)]))
+    quads = np.array(quads)
+    x, y = quads[..., 0], quads[..., 1]
+    shoelace = 0.5 * np.abs(np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1))
+    points = quads.reshape(-1, 3) @ ROTATION.T + SHIFT
+    faces = np.arange(len(points)).reshape(-1, 4)
+    assert face_areas(points, faces) == pytest.approx(shoelace, rel=1e-12)
+    triangles = np.concatenate([faces[:, [0, 1, 2]], faces[:, [0, 2, 3]]])
+    assert surface_area(points, triangles) == pytest.approx(shoelace.sum(), rel=1e-12)
+
+
+def test_faceted_cylinder_patch():
+    radius, angle, height = 3.0, 1.2, 2.0
+    areas = []
+    for n in (10, 20, 40):
+        points, faces = _cylinder(radius, angle, height, n)
+        areas.append(surface_area(points, faces))
+        assert areas[-1] == pytest.approx(height * n * 2 * radius * np.sin(angle / (2 * n)), rel=1e-12)
+    errors = np.abs(np.array(areas) - radius * angle * height)
+    assert np.log2(errors[:-1] / errors[1:]) == pytest.approx([2.0, 2.0], abs=0.02)
+
+
+def test_curved_bilinear_quad():
+    corners = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 1], [0, 1, 0]])  # exactly the surface z = x y
+    exact, _ = integrate.dblquad(lambda y, x: np.sqrt(1 + x * x + y * y), 0, 1, 0, 1, epsabs=1e-12)
+    assert surface_area(corners, np.array([[0, 1, 2, 3]])) == pytest.approx(exact, rel=2e-5)
+
+
+def test_boundary_loops_and_orifice_of_a_ring():
+    points, faces = _ring([1.0, 2.0, 3.5], 48)
+    loops = boundary_loops(faces)
+    assert sorted(len(loop) for loop in loops) == [48, 48]
+    outer = 0.5 * 48 * np.sin(2 * np.pi / 48) * 3.5**2
+    moved = points @ ROTATION.T + SHIFT
+    assert orifice_area(moved, faces, moved[-48:]) == pytest.approx(outer, rel=1e-12)
+    assert orifice_area(moved, faces, moved[:5]) == pytest.approx(outer / 3.5**2, rel=1e-12)
+
+
+def test_offset_of_a_closed_cylinder_scales_its_area():
+    points, faces = _cylinder(2.0, 2 * np.pi, 1.0, 64, closed=True)
+    base = surface_area(points, faces)
+    for distance in (0.3, -0.3):
+        # the faces wind with outward normals, so +distance moves outwards: radius 2 + distance
+        assert surface_area(offset_points(points, faces, distance), faces) == pytest.approx(
+            base * (2.0 + distance) / 2.0, rel=1e-12)
+
+
+def test_centre_region_of_a_square_is_a_central_disc():
+    n = 60
+    grid = np.linspace(-1, 1, n + 1)
+    points = np.array([[x, y, 0.0] for y in grid for x in grid])
+    faces = np.array([[j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1, (j + 1) * (n + 1) + i]
+                      for j in range(n) for i in range(n)])
+    chosen = centre_region(points @ ROTATION.T + SHIFT, faces, fraction=0.1)
+    area = face_areas(points, faces[chosen]).sum()
+    assert 0.4 <= area <= 0.4 + (2 / n) ** 2
+    centroids = points[faces[chosen]].mean(axis=1)
+    assert np.linalg.norm(centroids.mean(axis=0)) < 2 / n
+    radius = np.sqrt(0.4 / np.pi)
+    assert np.linalg.norm(centroids, axis=1).max() == pytest.approx(radius, abs=2 / n)
+
+
+INPUTS = trivalve_inputs()
+PAPER_DISEASED_ORIFICE_MM2 = 870.0  # mathur2022 Table 2 (end-systole); the annulus nodes are held in place
+
+
+@pytest.mark.skipif("1.0-diseased" not in INPUTS, reason="Texas TriValve 1.0 diseased input not present")
+def test_trivalve_diseased_orifice_and_leaflets():
+    """Texas TriValve 1.0 (Mathur et al. 2022, CC BY-NC-SA 4.0), undeformed diseased valve."""
+    logging.getLogger("skvalve.io.abaqus.reader").setLevel(logging.ERROR)
+    model = read_model(INPUTS["1.0-diseased"])
+    surfaces = leaflet_surfaces(model)
+    areas = valve_areas(surfaces, model.nodes, annulus_nodes(model))
+    # the paper's diseased annulus does not move (zero-displacement BCs): the undeformed mid-surface
+    # orifice must match Table 2 to within 2 %
+    assert areas.orifice["mid"] == pytest.approx(PAPER_DISEASED_ORIFICE_MM2, rel=0.02)
+    assert areas.orifice["atrial"] < areas.orifice["mid"] < areas.orifice["ventricular"]
+    # the annulus found geometrically on the atrial surface is the set of nodes held by the BCs
+    fixed = np.unique(np.concatenate([bc.nodes for bc in model.steps[0].boundary_conditions
+                                      if bc.amplitude == "Amp-1"]))
+    atrial = np.concatenate([s.atrial for s in surfaces.values()])
+    annulus = min(boundary_loops(atrial), key=lambda loop: len(np.setdiff1d(loop, fixed)))
+    assert sorted(annulus) == sorted(fixed)
+    # Steiner: a 0.78 mm layer's mid-surface area is the mean of its faces' areas to O(t^2 K)
+    for leaflet in areas.leaflet.values():
+        mean = 0.5 * (leaflet["atrial"] + leaflet["ventricular"])
+        assert leaflet["mid"] == pytest.approx(mean, rel=2e-3)
+        assert leaflet["atrial"] < leaflet["mid"] < leaflet["ventricular"]
+    for name, faces in areas.centre_faces.items():
+        assert areas.centre_area[name] == pytest.approx(0.1 * areas.leaflet[name]["mid"], rel=0.05)
+        assert len(faces) > 10
