@@ -6,8 +6,10 @@ import numpy as np
 import pytest
 import skfem as fem
 
-from skvalve.fem.fused import MixedFields, fused_response
+from skvalve.fem.constitutive import MaterialRegions
+from skvalve.fem.fused import MixedFields, assemble_regions, fused_response
 from skvalve.fem.kernels import element_forces, element_gradients, element_stiffness
+from skvalve.fem.space import Space
 from skvalve.kinematics import cofactor, determinant
 from skvalve.materials import (
     BimodularNeoHookean,
@@ -173,3 +175,31 @@ def test_bad_shapes_are_named():
     _, dN, dx = _space(HEX, fem.ElementHex1(), 3)
     with pytest.raises(ValueError, match="F must have shape"):
         fused_response(NeoHookean(1.0, 1.0))(np.zeros((3, 3, 2, 2)), dN, dx)
+
+
+@pytest.mark.parametrize("formulation", ["u", "up"])
+def test_assemble_regions_matches_material_regions(formulation):
+    """Two laws on two element sets, through MaterialRegions.evaluate + kernels vs assemble_regions."""
+    mesh = fem.MeshHex.init_tensor(*[np.linspace(0.0, 1.0, 3)] * 3)
+    space = Space(mesh, formulation)
+    laws = ([NeoHookean(1.0, 3.0), LeeSacks(1.0, 0.5, 2.0, D=0.2)] if formulation == "u"
+            else [IncompressibleNeoHookean(1.5), LeeSacks(1.0, 0.5, 2.0, D=0.2)])
+    materials = MaterialRegions(mesh, laws, regions=np.arange(mesh.nelements) % 2, mixed=formulation == "up")
+    F = _deformation(space.dN, 0.02, seed=6)
+    rng = np.random.default_rng(7)
+    p = None if formulation == "u" else np.einsum("eqa,ea->qe", space.Np, 0.05 * rng.standard_normal(
+        (space.nel, space.nb_p)))
+    got = assemble_regions(materials, F, space, True, p)
+    P, A, mixed = materials.evaluate(F, p, True)
+    nu = space.nb_u * 3
+    fe = element_forces(np.ascontiguousarray(P), space.dN, space.dx)
+    ke = np.zeros((space.nel, nu, nu))
+    element_stiffness(A, space.dN, space.dx, ke)
+    _close(got.P, P)
+    _close(got.forces[:, :nu], fe)
+    _close(got.stiffness[:, :nu, :nu], ke)
+    if mixed is not None:
+        Jbar, compliance, J, _ = mixed
+        wN = space.Np * space.dx[:, :, None]
+        _close(got.forces[:, nu:], np.einsum("eqa,qe->ea", wN, Jbar - J), scale=np.abs(got.forces).max())
+        _close(got.stiffness[:, nu:, nu:], -np.einsum("eqa,qe,eqb->eab", wN, compliance, space.Np))

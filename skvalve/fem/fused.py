@@ -64,8 +64,9 @@ from numba import njit, prange
 from ..kinematics import determinant
 from ..materials.base import Hyperelastic
 from ..materials.derivatives import InvariantDerivatives, PrincipalDerivatives
+from .constitutive import MaterialRegions, invert_volumetric
 
-__all__ = ["FusedLaw", "FusedResponse", "MixedFields", "fused_response"]
+__all__ = ["FusedLaw", "FusedResponse", "MixedFields", "fused_response", "assemble_regions"]
 
 _INVARIANT, _PRINCIPAL = 0, 1
 
@@ -427,3 +428,39 @@ def fused_response(law) -> FusedLaw | None:
     if hasattr(law, "principal_derivatives") and _defines_before(cls, "principal_derivatives", "response_C"):
         return FusedLaw(law, _PRINCIPAL)
     return None
+
+
+def assemble_regions(materials: MaterialRegions, F: np.ndarray, space, tangent: bool,
+                     pressure: np.ndarray | None = None) -> FusedResponse | None:
+    """Every material region of ``materials`` through the fused kernel, or ``None`` if one region has no fused form.
+
+    ``space`` provides ``dN``, ``dx``, ``nel``, ``ndofe`` and, for the mixed formulation (``pressure``
+    (nqp, nel) given), ``Np``; the result holds the full element forces and stiffness of the solid
+    term including the pressure rows (:math:`\bar J - J` and :math:`-1/U''` blocks).
+    """
+    fused = [fused_response(region.law) for region in materials.regions]
+    if any(f is None for f in fused):
+        return None
+    nel, nqp = space.nel, space.dx.shape[1]
+    single = len(materials.regions) == 1 and isinstance(materials.regions[0].elements, slice)
+    P = None if single else np.empty((3, 3, nqp, nel))
+    forces = None if single else np.empty((nel, space.ndofe))
+    stiffness = None if single or not tangent else np.empty((nel, space.ndofe, space.ndofe))
+    for region, evaluate in zip(materials.regions, fused, strict=True):
+        els = region.elements
+        mixed = None
+        if pressure is not None:
+            p = pressure[:, els]
+            if region.volumetric is not None:
+                Jbar, compliance = invert_volumetric(region.volumetric, p)
+            else:
+                Jbar, compliance = np.ones_like(p), np.zeros_like(p)
+            mixed = MixedFields(p, space.Np[els], Jbar, compliance)
+        response = evaluate(F[:, :, :, els], space.dN[els], space.dx[els], tangent, mixed, space.ndofe)
+        if single:
+            return response
+        P[:, :, :, els] = response.P
+        forces[els] = response.forces
+        if tangent:
+            stiffness[els] = response.stiffness
+    return FusedResponse(P, forces, stiffness)
