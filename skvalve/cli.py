@@ -1,45 +1,121 @@
-"""Command-line interface: ``skvalve materials`` and ``skvalve reproduce <paper>``."""
+"""Command-line interface: ``skvalve materials`` and ``skvalve reproduce <paper>``.
+
+Exit codes: 0 done; 1 ``--strict`` and a row is a regression or an unexplained disagreement; 2 bad
+arguments, an unusable ``--out`` or a paper not available yet; 130 interrupted (Ctrl-C).
+The heavy modules (numpy, scikit-fem, matplotlib, the papers) are imported inside the commands, so
+``skvalve --help`` and ``--version`` start fast — the one place skvalve imports inside functions.
+"""
 
 from __future__ import annotations
 
 import argparse
 import importlib
 import sys
+import tempfile
+import time
 from pathlib import Path
 
-PAPERS = ("buchanan2014", "thomas2019", "mathur2022")
+from . import __version__
+from .papers.registry import PAPERS, Paper
+from .papers.table import Row, Stage, Status, Written, format_header, format_row
+
+EXIT_STRICT, EXIT_USAGE, EXIT_INTERRUPTED = 1, 2, 130
+
+
+def _error(message: str) -> int:
+    print(f"skvalve: {message}", file=sys.stderr)
+    return EXIT_USAGE
+
+
+def check_out(out: Path) -> str | None:
+    """Create the output folder ``out`` if needed and check that it is writable; the problem, or None."""
+    if out.exists() and not out.is_dir():
+        return f"--out {out} exists and is not a folder"
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=out):
+            pass
+    except OSError as err:
+        return f"--out {out} is not a writable folder ({err.strerror or err})"
+    return None
 
 
 def _cmd_materials(args: argparse.Namespace) -> int:
-    from .materials.catalogue import main as materials_main
+    out = Path(args.out)
+    if not args.no_plot and (problem := check_out(out)):
+        return _error(problem)
+    from .papers.catalogue import catalogue, print_catalogue
 
-    return materials_main(out=Path(args.out), show=not args.no_plot)
+    entries = catalogue()
+    print_catalogue(entries)
+    if not args.no_plot:
+        from .papers.catalogue_figures import write_catalogue_figures
+
+        for path in write_catalogue_figures(entries, out):
+            print(f"wrote {path}")
+    return 0
+
+
+def _load_reproduce(paper: Paper):
+    """The paper's ``reproduce`` function, or None when its module does not exist yet."""
+    try:
+        module = importlib.import_module(paper.module)
+    except ModuleNotFoundError as err:
+        parents = {paper.module.rsplit(".", k)[0] for k in range(2)}
+        if err.name in parents:
+            return None
+        raise
+    return module.reproduce
+
+
+def _summary(rows: list[Row]) -> str:
+    count = {status: sum(r.status is status for r in rows) for status in Status}
+    return (f"{len(rows)} rows: {count[Status.AGREES]} agree within tolerance, {count[Status.DIFFERS]} differ for "
+            f"the reason in their note, {count[Status.UNEXPLAINED]} unexplained, "
+            f"{count[Status.REGRESSION]} regressions")
 
 
 def _cmd_reproduce(args: argparse.Namespace) -> int:
-    try:
-        module = importlib.import_module(f"skvalve.papers.{args.paper}")
-    except ModuleNotFoundError as err:
-        if err.name == f"skvalve.papers.{args.paper}":
-            print(f"skvalve: paper {args.paper!r} is not reproduced yet", file=sys.stderr)
-            return 2
-        raise
-    from .papers.table import print_table
-
+    paper = PAPERS[args.paper]
     out = Path(args.out)
-    rows = module.reproduce(out=out, full=args.full)
-    print_table(rows, title=f"skvalve reproduce {args.paper}")
-    n_ok = sum(row.ok for row in rows)
-    print(
-        f"\n{n_ok} of {len(rows)} quantities within tolerance of the paper; the note under each other row "
-        f"says why it differs. Figures: {out}/"
-    )
-    # A disagreement with a paper is a finding, not a crash: only --strict turns it into exit 1.
-    return 1 if args.strict and n_ok < len(rows) else 0
+    if problem := check_out(out):
+        return _error(problem)
+    reproduce = _load_reproduce(paper)
+    if reproduce is None:
+        return _error(f"reproduce {paper.key} is not available yet. When it is, it will compute: {paper.plan} "
+                      f"({paper.citation}).")
+    rows: list[Row] = []
+    written: list[Path] = []
+    start = time.perf_counter()
+    print(f"skvalve reproduce {paper.key}{' --full' if args.full else ''}: {paper.citation}")
+    print(format_header(), flush=True)
+    try:
+        for item in reproduce(out=out, full=args.full):
+            if isinstance(item, Row):
+                rows.append(item)
+                print(format_row(item), flush=True)
+            elif isinstance(item, Stage):
+                print(f"[{time.perf_counter() - start:6.1f} s] {item.text} ...", file=sys.stderr, flush=True)
+            elif isinstance(item, Written):
+                written.append(item.path)
+                print(f"[{time.perf_counter() - start:6.1f} s] wrote {item.path}", file=sys.stderr, flush=True)
+    except KeyboardInterrupt:
+        figures = ", ".join(p.name for p in written) or "none"
+        print(f"\nskvalve: interrupted after {time.perf_counter() - start:.0f} s. Finished: {len(rows)} rows "
+              f"(printed above), figures: {figures}.", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    print(f"\n{_summary(rows)}. Reference column: the paper's value, or * an exact one. Figures: {out}/")
+    failing = [r.quantity for r in rows if r.status.fails_strict]
+    if args.strict and failing:
+        print(f"skvalve: --strict: {len(failing)} rows are regressions or unexplained: {'; '.join(failing)}",
+              file=sys.stderr)
+        return EXIT_STRICT
+    return 0
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="skvalve", description=__doc__)
+    parser = argparse.ArgumentParser(prog="skvalve", description=__doc__.split("\n")[0])
+    parser.add_argument("--version", action="version", version=f"skvalve {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
     mat = sub.add_parser("materials", help="list the material laws with the papers' parameters and plot them")
@@ -47,11 +123,15 @@ def build_parser() -> argparse.ArgumentParser:
     mat.add_argument("--no-plot", action="store_true", help="print the table only")
     mat.set_defaults(func=_cmd_materials)
 
-    rep = sub.add_parser("reproduce", help="reproduce a paper's tables and figures")
-    rep.add_argument("paper", choices=PAPERS)
-    rep.add_argument("--out", default="skvalve_out", help="folder for the figures")
-    rep.add_argument("--full", action="store_true", help="converged meshes (slow)")
-    rep.add_argument("--strict", action="store_true", help="exit 1 if any quantity is outside its tolerance")
+    lines = "\n".join(f"  {p.key}: {p.plan}" for p in PAPERS.values())
+    rep = sub.add_parser("reproduce", help="reproduce a paper's tables and figures",
+                         description=f"Reproduce a paper's tables and figures.\n\n{lines}",
+                         formatter_class=argparse.RawDescriptionHelpFormatter)
+    rep.add_argument("paper", choices=list(PAPERS))
+    rep.add_argument("--out", default="skvalve_out", help="folder for the figures (created; must be writable)")
+    rep.add_argument("--full", action="store_true", help="converged meshes and complete sweeps (slow)")
+    rep.add_argument("--strict", action="store_true",
+                     help="exit 1 if a row is a regression or an unexplained disagreement with the paper")
     rep.set_defaults(func=_cmd_reproduce)
     return parser
 

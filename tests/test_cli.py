@@ -1,8 +1,18 @@
-"""Command-line interface: argument handling (the commands' numbers are tested elsewhere)."""
+"""Command-line interface: arguments, --out checks, streaming rows, --strict, Ctrl-C, papers not available yet.
+
+The commands' numbers are tested elsewhere; here stand-in ``reproduce`` modules yield chosen items.
+"""
+
+import sys
+import types
 
 import pytest
 
+import skvalve
 from skvalve.cli import build_parser, main
+from skvalve.papers.table import Reason, Row, Source, Stage, Written
+
+FAKE = "skvalve.papers.mathur2022.reproduce"
 
 
 def test_unknown_paper_is_rejected_by_argparse():
@@ -15,46 +25,76 @@ def test_missing_command_is_an_error():
         main([])
 
 
-def _fake_paper(monkeypatch, rows):
-    """Install a stand-in ``skvalve.papers.mathur2022`` whose reproduce() returns ``rows``."""
-    import sys
-    import types
+def test_version(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["--version"])
+    assert exit_info.value.code == 0
+    assert capsys.readouterr().out.strip() == f"skvalve {skvalve.__version__}"
 
-    module = types.ModuleType("skvalve.papers.mathur2022")
+
+def _fake_paper(monkeypatch, items):
+    """Install a stand-in ``skvalve.papers.mathur2022.reproduce`` whose reproduce() yields ``items``
+    (an exception instance among them is raised there)."""
+    module = types.ModuleType(FAKE)
     calls = []
 
     def reproduce(out, full):
         calls.append((out, full))
-        return rows
+        for item in items:
+            if isinstance(item, BaseException):
+                raise item
+            yield item
 
     module.reproduce = reproduce
-    monkeypatch.setitem(sys.modules, "skvalve.papers.mathur2022", module)
+    monkeypatch.setitem(sys.modules, FAKE, module)
     return calls
 
 
-def test_reproduce_exit_code_follows_the_rows(monkeypatch, tmp_path, capsys):
-    from skvalve.papers.table import Row
-
-    calls = _fake_paper(monkeypatch, [Row("a", 1.0, 1.0, 0.1), Row("b", 2.0, 2.05, 0.1)])
+def test_rows_and_stages_are_printed_as_they_come(monkeypatch, tmp_path, capsys):
+    calls = _fake_paper(monkeypatch, [Stage("step one"), Row("a", 1.0, 1.0, 0.1), Written(tmp_path / "f.png")])
     assert main(["reproduce", "mathur2022", "--out", str(tmp_path), "--full"]) == 0
     assert calls == [(tmp_path, True)]
-    assert "skvalve reproduce mathur2022" in capsys.readouterr().out
-    _fake_paper(monkeypatch, [Row("a", 1.0, 1.0, 0.1), Row("b", 2.0, 3.0, 0.1)])
-    assert main(["reproduce", "mathur2022", "--out", str(tmp_path)]) == 0
-    assert "1 of 2 quantities within tolerance" in capsys.readouterr().out
-    assert main(["reproduce", "mathur2022", "--out", str(tmp_path), "--strict"]) == 1
+    captured = capsys.readouterr()
+    assert "step one" in captured.err and "f.png" in captured.err
+    assert any(line.startswith("a ") and line.endswith("agrees") for line in captured.out.splitlines())
+    assert "1 rows: 1 agree within tolerance" in captured.out
 
 
-def test_reproduce_of_a_paper_without_module_says_so(monkeypatch, capsys):
-    import importlib
+def test_strict_fails_only_on_regressions_and_unexplained_rows(monkeypatch, tmp_path, capsys):
+    declared = Row("known", 1.0, 2.0, 0.1, note="model", expected_difference=Reason.MODEL_DIFFERENCE)
+    _fake_paper(monkeypatch, [Row("a", 1.0, 1.0, 0.1), declared])
+    assert main(["reproduce", "mathur2022", "--out", str(tmp_path), "--strict"]) == 0
+    for bad in (Row("b", 2.0, 3.0, 0.1), Row("c", 0.0, 1.0, 0.1, source=Source.EXACT)):
+        _fake_paper(monkeypatch, [declared, bad])
+        assert main(["reproduce", "mathur2022", "--out", str(tmp_path)]) == 0  # a finding, not a crash
+        assert main(["reproduce", "mathur2022", "--out", str(tmp_path), "--strict"]) == 1
+        assert bad.quantity in capsys.readouterr().err
 
-    real_import = importlib.import_module
 
-    def missing(name, *args):
-        if name == "skvalve.papers.mathur2022":
-            raise ModuleNotFoundError(f"No module named {name!r}", name=name)
-        return real_import(name, *args)
+@pytest.mark.parametrize("kind", ["file", "below a file"])
+def test_bad_out_is_refused_before_computing(monkeypatch, tmp_path, capsys, kind):
+    calls = _fake_paper(monkeypatch, [Row("a", 1.0, 1.0, 0.1)])
+    blocker = tmp_path / "taken"
+    blocker.write_text("")
+    out = blocker if kind == "file" else blocker / "figures"
+    assert main(["reproduce", "mathur2022", "--out", str(out)]) == 2
+    assert calls == []
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and str(out) in err and "Traceback" not in err
+    assert main(["materials", "--out", str(out)]) == 2
 
-    monkeypatch.setattr(importlib, "import_module", missing)
-    assert main(["reproduce", "mathur2022"]) == 2
-    assert "not reproduced yet" in capsys.readouterr().err
+
+def test_interrupt_reports_what_was_finished(monkeypatch, tmp_path, capsys):
+    _fake_paper(monkeypatch, [Row("a", 1.0, 1.0, 0.1), Written(tmp_path / "one.png"), KeyboardInterrupt()])
+    assert main(["reproduce", "mathur2022", "--out", str(tmp_path)]) == 130
+    err = capsys.readouterr().err
+    assert "interrupted" in err and "1 rows" in err and "one.png" in err
+
+
+@pytest.mark.parametrize("paper", ["thomas2019", "mathur2022"])
+def test_a_paper_not_available_yet_says_what_it_will_compute(monkeypatch, tmp_path, capsys, paper):
+    monkeypatch.setitem(sys.modules, f"skvalve.papers.{paper}.reproduce", None)  # the module does not exist
+    assert main(["reproduce", paper, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "not available yet" in err and "will compute" in err
+    assert ("Table 3" in err) if paper == "mathur2022" else ("RVE" in err)

@@ -3,7 +3,7 @@
 import pytest
 
 from skvalve.io.abaqus import read_materials, trivalve_input
-from skvalve.materials.catalogue import catalogue
+from skvalve.papers.catalogue import catalogue
 
 DECK = """** comment
 *Material, name=Chord

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from skvalve.analytic.rivlin import bend
+from skvalve.analytic.strainmap import fit_strain_map, polar_2d
 from skvalve.kinematics import polar_decomposition
 from skvalve.materials import IncompressibleNeoHookean
-from skvalve.strainmap import fit_strain_map, polar_2d
 
 
 def _markers(rng, n=150, length=0.3, thickness=0.318, x0=7.0):

@@ -1,49 +1,38 @@
-r"""buchanan2014 — FE studies of the layered strip (skvalve.fem, mixed Q2/Q1, plane strain and 3D).
+r"""buchanan2014 FE studies of the layered strip in pure bending (skvalve.fem, mixed Q2/Q1, plane strain and 3D).
 
 **Pure bending** (:func:`fe_pure_bending`): half strip with a symmetry plane at mid-length whose end
 face is rotated rigidly; the pivot height is found by secant iteration so that the axial force vanishes,
 and the FE is compared with Rivlin (:mod:`skvalve.analytic.rivlin`) at its own mid-length curvature.
 The 3D quarter strip (:func:`warping_study`) gives the edge-versus-centre warping of Figs. 7 and 11.
 
-The pin-ended end loading of the paper (Figs. 4, 9) is in :mod:`.buchanan2014_sliding`.
+The pin-ended end loading of the paper (Figs. 4, 9) is in :mod:`.sliding`; the rows in :mod:`.rows`.
 """
 
 from __future__ import annotations
 
 import numpy as np
+import skfem
+from scipy.optimize import brentq
 
-from ..analytic.rivlin import bend
-from .buchanan2014 import (
-    _SIGN,
-    CURVATURES,
-    FIG8_NEUTRAL_AXIS,
-    MODEL_STRIP,
-    MU_OUTER,
-    SPECIMEN_STRIP,
-    bimodular_bilayer,
-    trilayer,
-)
-from .table import Row
+from ...fem import Solid
+from .data import CURVATURES, FIG11_THICKNESSES, MU_OUTER, SPECIMEN_STRIP
+from .models import SIGN, trilayer
 
-__all__ = [
-    "strip_mesh", "fe_pure_bending", "warping_study", "warping_versus_thickness", "fe_rows", "figure_7", "figure_11",
-]
+__all__ = ["strip_mesh", "fe_pure_bending", "warping_study", "warping_versus_thickness"]
 
 
 def strip_mesh(layers: list, half_length: float, nx: int, ny_per_layer: int, half_width: float = 0.0, nz: int = 0):
     """Q-mesh of the half strip 0 ≤ X ≤ L/2 (2D) or quarter strip with 0 ≤ Z ≤ W/2 (3D, ``nz > 0``);
     returns ``(mesh, region index per element)`` with layer boundaries on element faces."""
-    import skfem as fem
-
     y = [0.0]
     for h, _ in layers:
         y.extend(np.linspace(y[-1], y[-1] + h, ny_per_layer + 1)[1:])
     x = np.linspace(0.0, half_length, nx + 1)
     if nz:  # graded towards the free edge Z = W/2, where the warping boundary layer sits
         z = half_width * np.sin(0.5 * np.pi * np.linspace(0.0, 1.0, nz + 1))
-        mesh = fem.MeshHex.init_tensor(x, np.array(y), z)
+        mesh = skfem.MeshHex.init_tensor(x, np.array(y), z)
     else:
-        mesh = fem.MeshQuad.init_tensor(x, np.array(y))
+        mesh = skfem.MeshQuad.init_tensor(x, np.array(y))
     y_centre = mesh.p[1, mesh.t].mean(axis=0)
     return mesh, np.searchsorted(np.cumsum([h for h, _ in layers]), y_centre)
 
@@ -74,10 +63,6 @@ def fe_pure_bending(layers: list, curvature: float, half_length: float, nx: int,
     the neutral axis where U11 = 1 on the mid-length line at the centre (Z = 0) and, in 3D, at the
     free edge (Z = W/2), plus ``stretch(Y, edge=False)`` giving Λ1 on that line.
     """
-    from scipy.optimize import brentq
-
-    from ..fem import Solid
-
     mesh, regions = strip_mesh(layers, half_length, nx, ny_per_layer, half_width, nz)
     H = float(sum(h for h, _ in layers))
     on_end = lambda X: np.isclose(X[0], half_length)
@@ -145,13 +130,10 @@ def warping_study(curvature: float = 0.2, half_length: float = 1.2, nx: int = 8,
     layers = trilayer(MU_OUTER, thickness)
     out = {"Y": Y, "layers": layers, "H": thickness}
     for direction in ("WC", "AC"):
-        fe = fe_pure_bending(layers, _SIGN[direction] * curvature, half_length, nx, ny,
+        fe = fe_pure_bending(layers, SIGN[direction] * curvature, half_length, nx, ny,
                              half_width=width / 2, nz=nz, tol=1e-3)
         out[direction] = dict(fe, centre=fe["stretch"](Y), edge=fe["stretch"](Y, edge=True))
     return out
-
-
-FIG11_THICKNESSES = (0.2, 0.3, 0.4)  # mm
 
 
 def warping_versus_thickness(thicknesses=FIG11_THICKNESSES, curvatures=CURVATURES, **mesh) -> np.ndarray:
@@ -162,88 +144,3 @@ def warping_versus_thickness(thicknesses=FIG11_THICKNESSES, curvatures=CURVATURE
             w = warping_study(kappa, thickness=h, **mesh)["AC"]
             out[i, j] = np.max(np.abs(w["edge"] - w["centre"]))
     return out
-
-
-def _warping_thickness_rows(table: np.ndarray) -> list[Row]:
-    """Fig. 11 trends (paper: warping grows with thickness and with curvature) as pass/fail rows."""
-    grows_with_h = float(np.all(np.diff(table, axis=0) > 0))
-    grows_with_k = float(np.all(np.diff(table, axis=1) > 0))
-    pairs = zip(FIG11_THICKNESSES, table, strict=True)
-    note = "; ".join(f"H={h}: " + ", ".join(f"{v:.4f}" for v in row) for h, row in pairs)
-    return [Row("Fig. 11 warping grows with thickness (1 = yes)", 1.0, grows_with_h, 0.0, note=note),
-            Row("Fig. 11 warping grows with curvature (1 = yes)", 1.0, grows_with_k, 0.0)]
-
-
-def fe_rows(full: bool = False) -> tuple[list[Row], dict]:
-    """FE-vs-Rivlin checks (plane strain), the 3D centre/edge warping and the pin-ended sliding study
-    (:func:`.buchanan2014_sliding.sliding_rows`); also returns the 3D and the sliding studies."""
-    rows: list[Row] = []
-    H = MODEL_STRIP.thickness
-    layers = trilayer(10.0, H)
-    meshes = [(12, 1), (24, 2), (48, 4)] + ([(96, 8)] if full else [])
-    errors = []
-    for nx, ny in meshes:
-        fe = fe_pure_bending(layers, 0.2, 1.2, nx, ny)
-        ref = bend(layers, fe["centre_curvature"])
-        errors.append((fe["elements"], fe["moment"] / ref.moment - 1, fe["neutral_axis"] / ref.neutral_axis - 1))
-    n_el, err_m, err_na = errors[-1]
-    history = "; ".join(f"{n} el: M {m:+.2%}, NA {a:+.2%}" for n, m, a in errors)
-    note = (f"tri-layer μS=10 kPa, Δκ=0.2, Q2/Q1 plane strain, Rivlin at the FE centre curvature; {history}. "
-            "First order: continuous Q1 pressure cannot jump at layer interfaces")
-    rows.append(Row(f"[FE] M / Rivlin − 1, {n_el} elements", 0.0, err_m, 0.01, note=note))
-    rows.append(Row(f"[FE] NA / Rivlin − 1, {n_el} elements", 0.0, err_na, 0.01))
-    bilayer = bimodular_bilayer(smoothed=True)
-    for direction in ("WC", "AC"):
-        fe = fe_pure_bending(bilayer, _SIGN[direction] * 0.2, 1.0, 24 if full else 12, 4 if full else 2, tol=1e-3)
-        ref = bend(bilayer, fe["centre_curvature"])
-        na = fe["neutral_axis"] / SPECIMEN_STRIP.thickness
-        rows.append(Row(f"[FE] bimodular NA {direction} / Rivlin − 1", 0.0, fe["neutral_axis"] / ref.neutral_axis - 1,
-                        0.01, note=(f"plane strain, {fe['elements']} elements, smoothed Eq. 4; FE NA/H = {na:.3f} "
-                                    f"(paper Fig. 8: {FIG8_NEUTRAL_AXIS[direction]}); M/Rivlin − 1 = "
-                                    f"{fe['moment'] / ref.moment - 1:+.2%}")))
-    warp = warping_study(nx=12 if full else 8, ny=2 if full else 1, nz=10 if full else 6)
-    for direction in ("WC", "AC"):
-        w = warp[direction]
-        ref = bend(warp["layers"], _SIGN[direction] * 0.2)
-        rows.append(Row(f"Fig. 7 max |Λ1 edge − centre| {direction}, Δκ=0.2", 0.02,
-                        float(np.max(np.abs(w["edge"] - w["centre"]))), 0.01,
-                        note=(f"paper: '~0.02' (Sect. 3.4), tol 0.01 for the approximate value; 3D quarter strip "
-                              f"{w['elements']} hexes, unimodular tri-layer (45 kPa); NA/H centre "
-                              f"{w['neutral_axis'] / warp['H']:.3f}, edge {w['neutral_axis_edge'] / warp['H']:.3f}, "
-                              f"plane strain {ref.normalised_neutral_axis:.3f}; 3D/plane-strain moment "
-                              f"{w['moment'] / ref.moment:.3f}")))
-    thickness_table = warping_versus_thickness() if full else None
-    if thickness_table is not None:
-        rows.extend(_warping_thickness_rows(thickness_table))
-    from .buchanan2014_sliding import sliding_rows  # it imports strip_mesh from here
-
-    sliding, study = sliding_rows(full)
-    return rows + sliding, {"warping": warp, "sliding": study, "warping_thickness": thickness_table}
-
-
-def figure_11(table: np.ndarray, ax=None):
-    """Fig. 11: edge–centre warping max |ΔΛ1| versus strip thickness, one line per curvature."""
-    import matplotlib.pyplot as plt
-
-    ax = ax if ax is not None else plt.subplots(figsize=(5, 4))[1]
-    for j, curvature in enumerate(CURVATURES):
-        ax.plot(FIG11_THICKNESSES, table[:, j], "o-", label=f"Δκ = {curvature} mm⁻¹")
-    ax.set(xlabel="thickness H (mm)", ylabel="max |Λ1 edge − Λ1 centre|", title="3D strip warping (Fig. 11)")
-    ax.legend()
-    return ax
-
-
-def figure_7(warp: dict, axes=None):
-    """Fig. 7 b, c: Λ1 through the thickness at the centre and at the free edge of the 3D strip."""
-    import matplotlib.pyplot as plt
-
-    axes = axes if axes is not None else plt.subplots(1, 2, figsize=(10, 4), sharey=True)[1]
-    Y = warp["Y"] / warp["H"]
-    for ax, direction in zip(axes, ("WC", "AC"), strict=True):
-        ax.plot(Y, warp[direction]["centre"], "C0", label="centre (Z = 0)")
-        ax.plot(Y, warp[direction]["edge"], "C3--", label="edge (Z = W/2)")
-        ax.axhline(1.0, color="0.6", lw=0.8)
-        ax.set(xlabel="normalised thickness (V → F)", title=f"3D strip, {direction}, Δκ = 0.2 mm⁻¹")
-    axes[0].set_ylabel("Λ1")
-    axes[0].legend()
-    return axes

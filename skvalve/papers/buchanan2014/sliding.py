@@ -1,4 +1,4 @@
-r"""buchanan2014 — pin-ended end loading and interlayer sliding (Sect. 2.2, Fig. 2b, Figs. 4 and 9).
+r"""buchanan2014 pin-ended end loading and interlayer sliding (Sect. 2.2, Fig. 2b, Figs. 4 and 9).
 
 Every section x of a pin-ended strip carries the pin force P (horizontal, along the pin-to-pin line)
 and so the moment M(x) = P·y(x), y the deflection from that line (Eq. 2 at the centre marker). Unlike
@@ -37,15 +37,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..analytic.rivlin import bend
-from ..materials import IncompressibleNeoHookean
-from .buchanan2014 import _SIGN, CURVATURES, LAMBDA_EXPERIMENT_ERROR, MODEL_STRIP, MU_OUTER, trilayer
-from .buchanan2014_fe import strip_mesh
-from .table import Row
+from ...fem import ConvergenceError, Solid
+from ...materials import IncompressibleNeoHookean
+from .data import CURVATURES, LAMBDA_EXPERIMENT_ERROR, MODEL_STRIP, MU_OUTER
+from .fe import strip_mesh
+from .models import SIGN, trilayer
 
 __all__ = [
-    "fe_end_loading", "at_curvature", "interface_jump", "sliding_study", "sliding_threshold", "sliding_rows",
-    "figure_4_9_end_loading",
+    "SLEEVE_LENGTH", "SLEEVE_STIFFENING", "PERTURBATION", "PERTURBATION_OFF", "SHORTENING", "SLIDING_SPONGIOSA_MODULI",
+    "SLIDING_SPONGIOSA_MODULI_DEFAULT", "fe_end_loading", "at_curvature", "interface_jump", "sliding_study",
+    "sliding_threshold",
 ]
 
 
@@ -56,7 +57,6 @@ PERTURBATION_OFF = 0.01  # load factor at which that force has been ramped back 
 SHORTENING = 2.8  # mm, pin displacement of the half model at t = 1 (past Δκ = 0.3 for every μS)
 SLIDING_SPONGIOSA_MODULI = (0.001, 0.01, 0.1, 1.0, 10.0, 45.0)  # kPa, the full sweep (1 Pa … 45 kPa)
 SLIDING_SPONGIOSA_MODULI_DEFAULT = (0.1, 1.0, 10.0, 45.0)  # kPa, the coarse sweep of the default run (Δκ = 0.2)
-LAMBDA_RESOLUTION = 0.001  # smallest stretch the particle tracking resolves (Sect. 2.4, Appendix 1)
 
 
 def fe_end_loading(layers: list, direction: str = "WC", nx: int = 28, ny_per_layer: int = 2,
@@ -76,9 +76,7 @@ def fe_end_loading(layers: list, direction: str = "WC", nx: int = 28, ny_per_lay
     section moment from the symmetry-plane reactions and from the integral of σ11 over the deformed section,
     and Λ1 = √(U11² + U12²) through the thickness.
     """
-    from ..fem import ConvergenceError, Solid
-
-    if direction not in _SIGN:
+    if direction not in SIGN:
         raise ValueError(f"direction must be 'AC' or 'WC'; got {direction!r}")
     if perturbation <= 0.0:
         raise ValueError(f"perturbation must be positive (kPa·mm); got {perturbation}")
@@ -98,7 +96,7 @@ def fe_end_loading(layers: list, direction: str = "WC", nx: int = 28, ny_per_lay
     solid.add_dirichlet(on_centre, 0.0, components=[0])
     solid.add_dirichlet(on_pin, np.array([-shortening, 0.0]))
     # WC stretches the ventricularis (bottom) face: push the centre down (−Y), for AC up; released at t_off
-    push = lambda t: np.array([0.0, _SIGN[direction] * perturbation * max(0.0, 1.0 - t / PERTURBATION_OFF)])
+    push = lambda t: np.array([0.0, SIGN[direction] * perturbation * max(0.0, 1.0 - t / PERTURBATION_OFF)])
     solid.add_nodal_force(lambda X: on_centre(X) & np.isclose(X[1], y_pin), push, ramp=False)
     factors = (np.arange(1, steps + 1) / steps) ** 2  # the deflection grows like √shortening
     try:
@@ -197,65 +195,3 @@ def sliding_threshold(study: dict, curvature: float, limit: float = LAMBDA_EXPER
     i = above[-1]
     t = (s[i] - limit) / (s[i] - s[i + 1])
     return float(10 ** ((1 - t) * np.log10(moduli[i]) + t * np.log10(moduli[i + 1])))
-
-
-def sliding_rows(full: bool = False) -> tuple[list[Row], dict]:
-    """Rows of the end-loading study: M = P·y against the section moment, the bonded strip against Rivlin,
-    and the μS threshold of measurable sliding beside the paper's '< 1 kPa' and '≥ 25 %'."""
-    moduli = SLIDING_SPONGIOSA_MODULI if full else SLIDING_SPONGIOSA_MODULI_DEFAULT
-    curvatures = CURVATURES if full else (0.2,)
-    study = sliding_study(moduli, curvatures)
-    bonded = study["runs"][MU_OUTER]
-    rows: list[Row] = []
-    for kappa in curvatures:
-        q = at_curvature(bonded, kappa)
-        note = (f"μS = 45 kPa, {bonded['elements']} Q2/Q1 elements incl. sleeves; P = {q['P']:.4f} kPa·mm, "
-                f"y = {abs(q['y']):.3f} mm; reaction moment {q['M_reaction']:.6f}; tol 1e-3: Gauss integration of "
-                "σ11 (6 points per layer) of a field whose Q1 pressure cannot jump at the interfaces")
-        rows.append(Row(f"[FE] end loading M = P·y vs ∫σ11·y dy, Δκ={kappa}", q["M_Py"], q["M_stress"], 1e-3,
-                        relative=True, note=note))
-        rivlin = bend(trilayer(MU_OUTER), _SIGN[study["direction"]] * q["a"]).profile(study["Y"])[0]
-        axial = q["P"] / (4 * MU_OUTER * study["H"])
-        rows.append(Row(f"[FE] end loading bonded Λ1 − Rivlin (max), Δκ={kappa}", 0.0,
-                        float(np.max(np.abs(q["stretch"] - rivlin))), 2e-3,
-                        note=(f"exact value 0 in the paper column; Rivlin at the FE's bending angle a = {q['a']:.4f}; "
-                              f"tol 2e-3 ≈ 2 × the axial strain P/(E'H) = {axial:.1e} that pure bending leaves out "
-                              "plus the discretisation")))
-        s = {mu: study["sliding"][(mu, kappa)] for mu in study["moduli"]}
-        listing = ", ".join(f"{1000 * mu:g} Pa: {v:+.4f}" for mu, v in s.items())
-        for limit, label in ((LAMBDA_EXPERIMENT_ERROR, "Λ1 error 0.0141"), (LAMBDA_RESOLUTION, "resolution 0.001")):
-            threshold = sliding_threshold(study, kappa, limit)
-            why = ("" if threshold < 1.0 else "; with the tracking resolution as the limit, sliding would be "
-                   "measurable up to this μS: the paper's '< 1 kPa' matches the Λ1 error 0.0141 instead")
-            rows.append(Row(f"Figs. 4/9 sliding measurable only if μS < 1 kPa ({label}), Δκ={kappa} (1 = yes)", 1.0,
-                            float(threshold < 1.0), 0.0,
-                            note=(f"threshold μS = {1000 * threshold:.3g} Pa (|S| = {limit}, log-interpolated); "
-                                  f"sliding S per μS ({study['direction']}): {listing}{why}")))
-    if 10.0 in study["moduli"]:  # 10 kPa ≈ 22 % of the outer modulus
-        worst = max(abs(study["sliding"][(10.0, kappa)]) for kappa in curvatures)
-        rows.append(Row("Abstract: bonded at μS ≥ 25 % (max |S| at μS = 10 kPa)", 0.0, worst, LAMBDA_RESOLUTION,
-                        note=("paper: 'tightly bonded when the spongiosa modulus is at least 25 % of the outer layers'"
-                              "; tol = the tracking resolution 0.001, the stricter of the two limits")))
-    return rows, study
-
-
-def figure_4_9_end_loading(study: dict, axes=None):
-    """Figs. 4/9: Λ1 through the thickness at the centre of the pin-ended strip, one line per μS, one panel
-    per Δκ (the sliding measure S in the legend)."""
-    import matplotlib.pyplot as plt
-
-    curvatures = study["curvatures"]
-    if axes is None:
-        axes = plt.subplots(1, len(curvatures), figsize=(4 * len(curvatures), 4), sharey=True, squeeze=False)[1][0]
-    Y = study["Y"] / study["H"]
-    for ax, kappa in zip(axes, curvatures, strict=True):
-        for k, mu in enumerate(sorted(study["moduli"])):
-            ax.plot(Y, study["profiles"][(mu, kappa)], f"C{k}",
-                    label=f"μS = {1000 * mu:g} Pa (S = {study['sliding'][(mu, kappa)]:+.3f})")
-        for f in (0.25, 0.55):
-            ax.axvline(f, color="0.8", lw=0.8)
-        ax.axhline(1.0, color="0.6", lw=0.8)
-        ax.set(xlabel="normalised thickness (V → F)", title=f"end loading, {study['direction']}, Δκ = {kappa} mm⁻¹")
-        ax.legend(fontsize=7)
-    axes[0].set_ylabel("Λ1 at the centre")
-    return axes
