@@ -98,3 +98,18 @@ def test_a_paper_not_available_yet_says_what_it_will_compute(monkeypatch, tmp_pa
     err = capsys.readouterr().err
     assert "not available yet" in err and "will compute" in err
     assert ("Table 3" in err) if paper == "mathur2022" else ("RVE" in err)
+
+
+@pytest.mark.parametrize("layout", ["file", "folder", "folder/Diseased"])
+def test_skvalve_trivalve_accepts_the_file_or_its_folder(monkeypatch, tmp_path, layout):
+    from skvalve.io.abaqus import trivalve_input
+
+    folder = tmp_path / "Diseased" if layout == "folder/Diseased" else tmp_path
+    folder.mkdir(exist_ok=True)
+    deck = folder / "Diseased_QuasiStatic.inp"
+    deck.write_text("** stand-in\n")
+    monkeypatch.setenv("SKVALVE_TRIVALVE", str(deck if layout == "file" else tmp_path))
+    assert trivalve_input() == deck
+    monkeypatch.setenv("SKVALVE_TRIVALVE", str(tmp_path / "empty"))
+    (tmp_path / "empty").mkdir()
+    assert trivalve_input() is None  # a folder without the input is not silently replaced by another copy
