@@ -113,3 +113,14 @@ def test_skvalve_trivalve_accepts_the_file_or_its_folder(monkeypatch, tmp_path, 
     monkeypatch.setenv("SKVALVE_TRIVALVE", str(tmp_path / "empty"))
     (tmp_path / "empty").mkdir()
     assert trivalve_input() is None  # a folder without the input is not silently replaced by another copy
+
+
+def test_interrupt_in_materials_exits_130(monkeypatch, tmp_path, capsys):
+    import skvalve.papers.catalogue_figures as catalogue_figures
+
+    def interrupt(entries, out):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(catalogue_figures, "write_catalogue_figures", interrupt)
+    assert main(["materials", "--out", str(tmp_path)]) == 130
+    assert "interrupted" in capsys.readouterr().err
