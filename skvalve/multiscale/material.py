@@ -133,6 +133,7 @@ class RVEMaterial:
             if not isinstance(net, Network):
                 raise TypeError(f"RVEMaterial: networks[{e}] is a {type(net).__name__}, not a Network")
         self.matrix, self.fiber = matrix, fiber
+        self.psi, self.fiber_diameter, self.tol = psi, fiber_diameter, tol
         self.n_elements, self.n_points = len(networks), int(n_points)
         self.networks = networks
         per_point = [net for net in networks for _ in range(self.n_points)]
