@@ -223,3 +223,40 @@ def test_elements_may_be_named_by_a_set_before_they_are_defined(tmp_path):
     path = tmp_path / "forward.inp"
     path.write_text("*Node\n1, 0, 0, 0\n2, 1, 0, 0\n*Elset, elset=W\n 1,\n*Element, type=CONN3D2\n1, 1, 2\n")
     assert read_model(path).element_set("w").indices.tolist() == [0]
+
+
+SMALL_BAD = {
+    "*Node\n1,0,0,0\n2,1,0,0\n*Element, type=T3D2\n99999999999999999999999, 1, 2\n": "out of range",
+    "*Node\n99999999999999999999999,0,0,0\n": "out of range",
+    "*Node\n1,0,0,0\n*Nset, nset=A, generate\n1, 99999999999, 1\n": "more than",
+    "*Node\n-1,0,0,0\n": "not positive",
+    "*Node\n1,0,0,0\n*Node\n1,1,0,0\n": "already defined",
+    "*Node\n1,0,0,0\n2,1,0,0\n*Element, type=T3D2\n1, 1,\n": "cut short",
+    "*Node\n1,0,0,0\n2,1,0,0\n*Element, type=C3D8R\n1, 1, 2\n": "1 nodes|2 nodes",
+    "*Amplitude, name=A\n0, 0, 1\n": "pairs",
+    "*Amplitude, name=A, definition=SMOOTH STEP\n0, 0, 0, 1\n": "increase",
+    "*Step\n*Static\n": "no \\*End Step",
+    "*Part, name=P\n*Node\n1, 1e308, 0, 0\n*End Part\n*Assembly, name=A\n*Instance, name=I, part=P\n1e308, 0, 0\n"
+    "*End Instance\n*End Assembly\n": "overflow",
+    "*Part, name=P\n*Node\n1, 1, 0, 0\n*End Part\n*Assembly, name=A\n*Instance, name=I, part=P\n0,0,0\n"
+    "0,0,0,0,0,0,90\n*End Instance\n*End Assembly\n": "coincide",
+    "*Part, name=P\n*End Part\n*Assembly, name=A\n*Instance, name=I, part=Q\n*End Instance\n*End Assembly\n":
+        "unknown part",
+    "*Node\n1,0,0,0\n*Nset, nset=A, instance=I\n1\n": "only allowed in the assembly",
+    "1, 2, 3\n": "before any keyword",
+    "*Node\n1,0,0,0\n*Surface, name=S\nE, S1\n": "unknown element set",
+    "*Material, name=M\n*Hyperelastic, OGDEN, N=-2\n1\n": "out of range",
+    "*Density\n1\n": "outside a \\*Material",
+    "*Node, system=C\n1, 1, 0, 0\n": "SYSTEM=R",
+    "*Node\n1,0,0,0\n*Boundary\n1, 9\n": "degree of freedom 9",
+    "*Material, name=M\n\x00": "NUL",
+}
+
+
+@pytest.mark.parametrize(("text", "message"), list(SMALL_BAD.items()))
+def test_small_bad_decks(tmp_path, text, message):
+    path = tmp_path / "small.inp"
+    path.write_text(text)
+    with pytest.raises(AbaqusParseError, match=message) as info:
+        read_model(path)
+    assert "small.inp" in str(info.value)

@@ -89,6 +89,8 @@ class Card:
 
 def _split_keyword_fields(text: str, location: Location) -> list[str]:
     """Comma-separated fields of a keyword line, honouring double quotes."""
+    if '"' not in text:
+        return [f.strip() for f in text.split(",")]
     fields, current, quoted = [], [], False
     for char in text:
         if char == '"':
@@ -222,11 +224,18 @@ def parse_float(token: str, card: Card, location: Location, what: str = "value")
     return value
 
 
+#: Largest magnitude accepted for an integer field (labels are at most 9 digits in Abaqus).
+MAX_INT = 2**53
+
+
 def parse_int(token: str, card: Card, location: Location, what: str = "integer") -> int:
-    """A strictly read ASCII integer."""
+    """A strictly read ASCII integer of magnitude at most :data:`MAX_INT`."""
     if not _INT.fullmatch(token):
         raise card.error(f"{what} is not an integer: {token[:40]!r}", location)
-    return int(token)
+    value = int(token)
+    if abs(value) > MAX_INT:
+        raise card.error(f"{what} is out of range: {token[:40]!r}", location)
+    return value
 
 
 def data_values(card: Card, blank: float | None = 0.0) -> list[float]:
@@ -265,6 +274,8 @@ def fast_table(card: Card, columns: int, integer: bool) -> np.ndarray | None:
     try:
         table = np.array(rows, dtype=np.int64 if integer else float)
     except (ValueError, OverflowError):
+        return None
+    if integer and np.any(np.abs(table) > MAX_INT):
         return None
     if not integer and not np.all(np.isfinite(table)):
         return None

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import Location
+from .errors import AbaqusParseError, Location
 from .lexer import Card
 from .model import ElementBlock, ElementSet, Instance, NodeSet, ReadWarning, Section, Surface, SurfaceFaces
 
@@ -154,10 +154,14 @@ def rotation_matrix(a: np.ndarray, b: np.ndarray, angle_degrees: float) -> np.nd
 
 def instance_part(assembly: MeshScope, instance: Instance, part: MeshScope) -> None:
     """Append the nodes, elements, sets, surfaces and sections of ``part`` to the assembly as ``instance``."""
-    xyz = part.all_coordinates() + instance.translation
-    if instance.rotation is not None:
-        a, b, angle = instance.rotation
-        xyz = (xyz - a) @ rotation_matrix(a, b, angle).T + a
+    with np.errstate(over="ignore", invalid="ignore"):
+        xyz = part.all_coordinates() + instance.translation
+        if instance.rotation is not None:
+            a, b, angle = instance.rotation
+            xyz = (xyz - a) @ rotation_matrix(a, b, angle).T + a
+    if not np.all(np.isfinite(xyz)):
+        raise AbaqusParseError(f"instance {instance.name!r}: coordinates overflow after its transform",
+                               instance.location, "Instance")
     node_offset, element_offset = assembly.n_nodes, assembly.n_elements
     instance.node_offset, instance.element_offset = node_offset, element_offset
     assembly.coordinates.append(xyz)

@@ -6,7 +6,7 @@ import numpy as np
 
 from .elements import FACE_LABELS, NODES_PER_ELEMENT, SHELL_FACE_LABELS, is_shell_like
 from .errors import Location
-from .lexer import _INT, Card, fast_table, parse_float, parse_int, split_fields
+from .lexer import _INT, MAX_INT, Card, fast_table, parse_float, parse_int, split_fields
 from .mesh import MeshScope
 from .model import ElementBlock, Section, Surface, SurfaceFaces
 
@@ -63,10 +63,14 @@ def read_nodes(card: Card, scope: MeshScope) -> None:
     if card.parameters.get("system", "R").upper() != "R":
         raise card.error("only rectangular nodal coordinates (SYSTEM=R) are supported")
     table = fast_table(card, 4, integer=False)
-    if table is not None and all(_INT.fullmatch(text.split(",", 1)[0].strip()) for text in card.texts):
+    if table is not None and np.all(np.abs(table[:, 0]) <= MAX_INT) and \
+            all(_INT.fullmatch(text.split(",", 1)[0].strip()) for text in card.texts):
         labels, xyz = table[:, 0].astype(np.int64), table[:, 1:]
     else:
         labels, xyz = _read_node_lines(card)
+    if np.any(labels <= 0):
+        row = int(np.flatnonzero(labels <= 0)[0])
+        raise card.error(f"node label {int(labels[row])} is not positive", card.data[row].location)
     keep = scope.keep_last(labels, card, "node")
     indices = scope.add_nodes(labels[keep], xyz[keep], card)
     if "nset" in card.parameters:
@@ -98,6 +102,8 @@ def read_elements(card: Card, scope: MeshScope) -> None:
     table = fast_table(card, per_element + 1, integer=True)
     if table is None:
         table = _read_element_lines(card, element_type, per_element)
+    if np.any(table[:, 0] <= 0):
+        raise card.error(f"element label {int(table[table[:, 0] <= 0, 0][0])} is not positive")
     table = table[scope.keep_last(table[:, 0], card, "element")]
     where = card.data[0].location if card.data else card.location
     connectivity = _node_columns(table[:, 1:], scope, card, where)
@@ -173,7 +179,7 @@ def read_set(card: Card, scope: MeshScope) -> None:
             if not token:
                 raise card.error("blank field in a set definition", line.location)
             if _INT.fullmatch(token):
-                labels.append(int(token))
+                labels.append(parse_int(token, card, line.location, "label"))
                 label_lines.append(line.location)
             else:
                 resolve = resolve_nodes if nodes else resolve_elements
