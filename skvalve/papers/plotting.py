@@ -37,11 +37,8 @@ STYLE = {
 
 @contextlib.contextmanager
 def readable_style() -> Iterator[None]:
-    """Non-interactive backend and :data:`STYLE` for the figures drawn inside the block."""
-    import matplotlib.pyplot as plt
-
-    if matplotlib.get_backend().lower() not in ("agg", "module://matplotlib_inline.backend_inline"):
-        plt.switch_backend("Agg")
+    """:data:`STYLE` for the figures drawn inside the block (the backend is left as it is: without a
+    display matplotlib falls back to Agg by itself)."""
     with matplotlib.rc_context(STYLE):
         yield
 
