@@ -1,11 +1,18 @@
 """The dataclasses of a read Abaqus model (:class:`AbaqusModel` and its parts).
 
-Numbering: every node and element of the assembled model has a 0-based *global index*. Nodes of each
-part instance (coordinates moved by the instance's translation and rotation) and of the assembly
-(reference points, or all nodes of an input without parts) are stacked in file order; elements are
-numbered block by block. Sets, surfaces, sections, boundary conditions and constraints hold global
-indices. Names are case-insensitive as in Abaqus; a set of part ``P`` instanced as ``I`` is reached as
-``"I.setname"``, and node ``12`` of ``I`` as ``"I.12"`` (:meth:`AbaqusModel.node_indices`).
+Numbering: every node and element of the assembled model has a 0-based *global index*. Nodes defined
+outside parts (assembly reference points, or all nodes of an input without parts) come first, in file
+order; then the nodes of each part instance in instance order, moved by the instance's translation and
+rotation. Elements are numbered block by block in the same way. Sets, surfaces, sections, boundary
+conditions and constraints hold global indices. Names are case-insensitive as in Abaqus; a set of part
+``P`` instanced as ``I`` is reached as ``"I.setname"``, and node ``12`` of ``I`` as ``"I.12"``
+(:meth:`AbaqusModel.node_indices`); ``node_scopes``/``node_labels`` give each global node's instance
+(index into ``scopes``, ``""`` = assembly) and its label there.
+
+Steps keep the history data as written: ``BoundaryCondition.op == "NEW"`` means that the conditions of
+earlier steps are released at the start of this step (Abaqus applies ``OP=NEW`` to the whole step), the
+step's own conditions all apply together; ``amplitude`` names an :class:`Amplitude` (None: the step's
+default ramp); ``DistributedLoad`` type ``P`` is a follower pressure acting against the face normal.
 """
 
 from __future__ import annotations
@@ -182,7 +189,8 @@ class ContactPair:
 
 @dataclass
 class GeneralContact:
-    """``*Contact`` with its inclusions (surface pairs; ``(s, None)`` = self contact of s, ``()`` = all)."""
+    """``*Contact`` (general contact) with its inclusions: ``(s1, s2)`` a pair, ``(s,)`` self contact of
+    ``s``, ``()`` all exterior faces; property assignments as written (surface, surface, interaction)."""
 
     inclusions: list[tuple[str, ...]]
     property_assignments: list[tuple[str, str, str]]
