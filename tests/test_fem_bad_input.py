@@ -171,3 +171,16 @@ def test_checkpoint_resume_reproduces_an_uninterrupted_run(tmp_path):
     (tmp_path / "step_00004.npz").write_bytes(b"truncated")
     with pytest.raises(ValueError, match="step_00004.npz is damaged"):
         resume(build(), tmp_path)
+
+
+def test_fully_prescribed_problem_gives_its_reactions():
+    """Every dof prescribed (a homogeneous stretch): no Newton iteration, reactions = closed form."""
+    solid = Solid(box(1), LAW)
+    solid.add_dirichlet(lambda X: np.ones(X.shape[1], dtype=bool), lambda X, t: np.array([0.2 * t * X[0],
+                                                                                       0 * X[1], 0 * X[2]]))
+    result = solid.solve(steps=2, progress=False)
+    assert result.iterations == 0
+    force = result.reaction(lambda X: X[0] == 1.0)[0]
+    # confined (lateral stretch 1) uniaxial stretch: P11 of the law at F = diag(1.2, 1, 1) on a unit face
+    F = np.diag([1.2, 1.0, 1.0])
+    assert force == pytest.approx(LAW.pk1(F)[0, 0], rel=1e-12)

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..kinematics import green_lagrange, polar_decomposition
+from ..materials.base import Hyperelastic
 from .loads import embed_3d
 
 __all__ = ["PointData", "locate", "element_centres"]
@@ -77,6 +78,12 @@ class PointData:
                 idx = np.flatnonzero(np.isin(self.elements, region.elements))
             if idx.size == 0:
                 continue
+            if not isinstance(region.law, Hyperelastic):
+                raise ValueError(
+                    f"{type(region.law).__name__} is a quadrature-point material: its stress exists only at the "
+                    "Gauss points it was built for, not at arbitrary points; use its own field output "
+                    "(e.g. skvalve.multiscale)"
+                )
             sig = region.law.cauchy(F[:, :, idx][:, :, None, :])[:, :, 0, :]
             if p is not None:
                 sig = sig - p[idx] * np.eye(3)[:, :, None]

@@ -144,6 +144,9 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
         prescribed[fixed] = new_values - old_values
         rhs = residual + problem.apply(tangent, prescribed)
         u[fixed] = new_values
+    if free.size == 0:  # every dof prescribed: the state is known, the residual gives the reactions
+        residual, tangent = problem.assemble(u, t_new, tangent=True, step=step)
+        return u, residual, [], tangent
     reference = _reference(problem, residual, fixed)
     norm = np.linalg.norm(rhs[free])
     history = []
