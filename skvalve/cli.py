@@ -1,4 +1,4 @@
-"""Command-line interface: ``skvalve materials`` and ``skvalve reproduce <paper>``.
+"""Command-line interface: ``skvalve materials``, ``skvalve reproduce <paper>``, ``skvalve valve info FILE``.
 
 Exit codes: 0 done; 1 ``--strict`` and a row is a regression or an unexplained disagreement; 2 bad
 arguments, an unusable ``--out`` or a paper not available yet; 130 interrupted (Ctrl-C).
@@ -113,6 +113,27 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_valve_info(args: argparse.Namespace) -> int:
+    path = Path(args.file)
+    if not path.is_file():
+        return _error(f"valve info: {path} is not a file (give an Abaqus .inp, e.g. "
+                      "../shared/data/texas_trivalve/Diseased_QuasiStatic.inp)")
+    out = Path(args.out)
+    if problem := check_out(out):
+        return _error(problem)
+    from .io.abaqus import AbaqusParseError
+    from .valve.info import valve_info
+
+    try:
+        summary = valve_info(path, out)
+    except AbaqusParseError as err:
+        return _error(str(err))
+    print(summary.to_text())
+    for written in summary.outputs:
+        print(f"wrote {written}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="skvalve", description=__doc__.split("\n")[0])
     parser.add_argument("--version", action="version", version=f"skvalve {__version__}")
@@ -133,6 +154,13 @@ def build_parser() -> argparse.ArgumentParser:
     rep.add_argument("--strict", action="store_true",
                      help="exit 1 if a row is a regression or an unexplained disagreement with the paper")
     rep.set_defaults(func=_cmd_reproduce)
+
+    valve = sub.add_parser("valve", help="whole-valve models read from Abaqus inputs")
+    valve_sub = valve.add_subparsers(dest="valve_command", required=True)
+    info = valve_sub.add_parser("info", help="summarise an Abaqus valve input and draw the undeformed valve")
+    info.add_argument("file", help="Abaqus input (.inp), e.g. a Texas TriValve model")
+    info.add_argument("--out", default="skvalve_out/valve_info", help="folder for summary.txt and undeformed.png")
+    info.set_defaults(func=_cmd_valve_info)
     return parser
 
 
