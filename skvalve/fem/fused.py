@@ -98,7 +98,7 @@ class FusedResponse:
 # ----------------------------------------------------------------------------- kernel
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _inverse_transpose(F, H):
     """H = F^{-T}; returns det F."""
     a, b, c = F[0, 0], F[0, 1], F[0, 2]
@@ -111,7 +111,7 @@ def _inverse_transpose(F, H):
     return J
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _invariant_point(F, H, J, D, a, has_direction, S, A, tangent, G, M, B):
     """S and A at one point of a law psi(I1bar, J, I4); D = (d1, dJ, d11, d1J, dJJ, d4, d14, dJ4, d44).
 
@@ -185,7 +185,7 @@ def _invariant_point(F, H, J, D, a, has_direction, S, A, tangent, G, M, B):
                     A[i, j, k, L] = v
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _principal_point(F, D, V, S, A, tangent, c, n, theta):
     """S and A at one point of a law psi(c1, c2, c3); D = (psi_a (3), psi_ab (9)), V[:, a] = N_a.
 
@@ -227,7 +227,7 @@ def _principal_point(F, D, V, S, A, tangent, c, n, theta):
                     A[i, j, k, L] = v
 
 
-@njit(parallel=True, cache=True)
+@njit(parallel=True, cache=True, error_model="numpy")
 def _fused_kernel(kind, F, D, aux, has_direction, dN, dx, tangent, pressure, Np, Jbar, compliance, ndofe):
     nel, nqp, nb, dim = dN.shape
     nbp = Np.shape[2]
