@@ -4,9 +4,11 @@ Expected values are written by hand from the deck (coordinates after a 90 degree
 set contents, face labels), not taken from the reader.
 """
 
+import logging
+
 import pytest
 
-from skvalve.io.abaqus import AbaqusParseError, read_model
+from skvalve.io.abaqus import AbaqusParseError, read_materials, read_model
 
 DECK = """** a two-part model: a cube of one C3D8R brick with a truss hanging from it
 *Heading
@@ -260,3 +262,19 @@ def test_small_bad_decks(tmp_path, text, message):
     with pytest.raises(AbaqusParseError, match=message) as info:
         read_model(path)
     assert "small.inp" in str(info.value)
+
+
+def test_ignored_keywords_are_reported_once(tmp_path, caplog):
+    path = tmp_path / "deck.inp"
+    path.write_text(DECK)
+    with caplog.at_level(logging.WARNING, logger="skvalve.io.abaqus.reader"):
+        read_model(path)
+    reports = [r for r in caplog.records if "not used by the implicit model" in r.getMessage()]
+    assert len(reports) == 1 and "*Density x1" in reports[0].getMessage()
+
+
+def test_read_materials_agrees_with_read_model(model):
+    materials = read_materials(model.path)
+    assert list(materials) == list(model.materials)
+    for name, material in materials.items():
+        assert material.options == model.materials[name].options

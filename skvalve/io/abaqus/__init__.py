@@ -43,7 +43,7 @@ from .model import (
     SurfaceInteraction,
     Transform,
 )
-from .reader import IGNORED_KEYWORDS, read_model
+from .reader import IGNORED_KEYWORDS, read_materials, read_model
 
 __all__ = [
     "read_model", "read_materials", "trivalve_input", "trivalve_inputs", "AbaqusParseError", "Location",
@@ -64,11 +64,6 @@ TRIVALVE_FILES = {
     "1.1-healthy": Path("texas_trivalve_1.1") / "Healthy" / "Healthy_QuasiStatic.inp",
     "1.1-diseased": Path("texas_trivalve_1.1") / "Diseased" / "Diseased_QuasiStatic.inp",
 }
-
-
-def read_materials(path: str | os.PathLike) -> dict[str, AbaqusMaterial]:
-    """All ``*Material`` blocks of an Abaqus input file, by name as written (the whole file is checked)."""
-    return read_model(path).materials
 
 
 def _data_folder() -> Path | None:

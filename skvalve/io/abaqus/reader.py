@@ -23,7 +23,7 @@ from .model import AbaqusModel, IgnoredKeyword, Instance
 from .state import ParseState
 from .step_cards import HISTORY_HANDLERS
 
-__all__ = ["read_model", "IGNORED_KEYWORDS"]
+__all__ = ["read_model", "read_materials", "IGNORED_KEYWORDS"]
 
 logger = logging.getLogger(__name__)
 
@@ -257,3 +257,22 @@ def read_model(path: str | os.PathLike) -> AbaqusModel:
         logger.warning("%s: not used by the implicit model (see model.ignored): %s", path, listing)
     return model
 
+
+
+def read_materials(path: str | os.PathLike) -> dict[str, AbaqusMaterial]:
+    """All ``*Material`` blocks of an Abaqus input file, by name as written.
+
+    Reads only the materials (with the same strict rules as :func:`read_model`: counts, numbers,
+    duplicate names, ``*Include``), so a file whose other keywords the model reader rejects still works.
+    """
+    state = ParseState(Path(path))
+    for card in read_cards(Path(path)):
+        if card.keyword == "material":
+            _material(card, state)
+        elif state.material is not None and card.keyword in MATERIAL_OPTIONS:
+            _material_option(card, state)
+        elif card.keyword in MATERIAL_OPTIONS:
+            raise card.error("material option outside a *Material")
+        else:
+            state.material = None
+    return state.materials
