@@ -38,6 +38,14 @@ def test_bimodular_layers_are_stiffer_in_tension():
         assert law.mu_tension > law.mu_compression
 
 
+def test_thomas2019_matrix_has_the_small_strain_youngs_modulus():
+    """thomas2019 Eq. 10 with G, ν: free uniaxial stress has slope E = 2G(1 + ν) at λ = 1 (linear elasticity)."""
+    law = _entry("matrix").law
+    h = 1e-6
+    sigma = uniaxial(law, np.array([1 - h, 1 + h]), incompressible=False).cauchy[0]
+    assert (sigma[1] - sigma[0]) / (2 * h) == pytest.approx(2 * 2.1e3 * (1 + 0.49), rel=1e-6)
+
+
 @needs_trivalve
 def test_texas_trivalve_leaflets_match_the_papers_bulk_modulus_and_are_credited():
     """mathur2022 Sect. 2.8: the file's D gives the bulk modulus 99.67 kPa and, with the small-strain shear

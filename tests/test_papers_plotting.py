@@ -1,5 +1,7 @@
 """Figure files are written atomically and readable (issue 12 items 4 and 7)."""
 
+import os
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -35,6 +37,9 @@ def test_a_figure_is_written_at_the_readable_size(tmp_path):
         assert min(t.get_fontsize() for t in legend.get_texts()) >= 9
         path = save_figure(fig, tmp_path / "ok.png")
     assert matplotlib.image.imread(path).shape[1] == round(6.4 * DPI)
+    umask = os.umask(0)
+    os.umask(umask)
+    assert path.stat().st_mode & 0o777 == 0o666 & ~umask  # as any new file, not owner-only
     narrow = plt.figure(figsize=(4.0, 3.0))
     with pytest.raises(ValueError, match="wide"):
         save_figure(narrow, tmp_path / "narrow.png")

@@ -1,9 +1,9 @@
 """Catalogue of the material laws with the papers' parameters (``skvalve materials``).
 
 Each entry is a library law built from a paper's data module: buchanan2014 (:mod:`.buchanan2014.data`:
-Eq. 3 μ = 45 kPa, the Fig. 3 Ogden family, Eq. 4 with Table 3) and mathur2022 (the Texas TriValve input
-read by :mod:`.mathur2022.data`, present only when the shared data set is found). Units: kPa for stresses
-and moduli (D in 1/kPa). Figures: :mod:`.catalogue_figures`.
+Eq. 3 μ = 45 kPa, the Fig. 3 Ogden family, Eq. 4 with Table 3; kPa), thomas2019 (:mod:`.thomas2019.models`:
+matrix Eq. 10 and fiber Eq. 9; Pa) and mathur2022 (the Texas TriValve input read by :mod:`.mathur2022.data`,
+present only when the shared data set is found; kPa, D in 1/kPa). Figures: :mod:`.catalogue_figures`.
 """
 
 from __future__ import annotations
@@ -17,6 +17,8 @@ from .buchanan2014.data import MU_OUTER, TABLE3
 from .buchanan2014.models import CIRCUMFERENTIAL
 from .mathur2022.data import CREDIT, LEAFLETS, read_trivalve_materials
 from .mathur2022.models import chordae_law, leaflet_law
+from .thomas2019 import data as thomas2019
+from .thomas2019.models import fiber_law, matrix_law
 
 __all__ = ["CatalogueEntry", "catalogue", "describe", "print_catalogue"]
 
@@ -57,6 +59,17 @@ def _buchanan2014() -> list[CatalogueEntry]:
     return entries
 
 
+def _thomas2019() -> list[CatalogueEntry]:
+    d = thomas2019
+    return [
+        CatalogueEntry("thomas2019 non-collagenous matrix", "thomas2019", "Eq. 10 / Eq. 13", matrix_law(), "Pa",
+                       f"§3: G = {d.G:g} Pa; §2.4: nu = {d.NU}", "thomas2019_matrix", (0.8, 1.5)),
+        CatalogueEntry("thomas2019 collagen fiber", "thomas2019", "Eq. 9", fiber_law(), "E_f in Pa; force in nN",
+                       f"§3: E_f = {d.E_F:g} Pa, beta = {d.BETA}, lambda_c = {d.LAMBDA_C}; §2.5: d = "
+                       f"{d.FIBER_DIAMETER * 1e9:g} nm", "thomas2019_fiber", (0.95, 1.2)),
+    ]
+
+
 def _mathur2022() -> list[CatalogueEntry]:
     path = trivalve_input()
     if path is None:
@@ -80,7 +93,7 @@ def _mathur2022() -> list[CatalogueEntry]:
 
 def catalogue() -> list[CatalogueEntry]:
     """All catalogue entries (laws built with the papers' parameters); mathur2022 only when its data are found."""
-    return _buchanan2014() + _mathur2022()
+    return _buchanan2014() + _thomas2019() + _mathur2022()
 
 
 def describe(law: object) -> str:

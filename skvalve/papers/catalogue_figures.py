@@ -43,7 +43,8 @@ def group_figure(entries: Sequence[CatalogueEntry]):
                title=f"{first.paper}: {title}")
         ax.axhline(0.0, color="0.8", lw=0.5)
     if any(not e.law.incompressible for e in entries):
-        axes[0].plot([], [], "k--", lw=1, label="compressible (free lateral stretch)")
+        axes[0].plot([], [], "k--", lw=1, label="dashed: the compressible law with free lateral stretch; solid: "
+                                                "its incompressible limit")
     fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=2)
     return fig
 

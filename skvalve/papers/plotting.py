@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import os
-import tempfile
+import secrets
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -52,8 +52,9 @@ def save_figure(fig, path: Path, dpi: int = DPI) -> Path:
     width = fig.get_size_inches()[0]
     if width < MIN_WIDTH_IN:
         raise ValueError(f"figure for {path.name} is {width:.1f} in wide; at least {MIN_WIDTH_IN} in are readable")
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".png.part", dir=path.parent)
-    os.close(handle)
+    # a unique name in the same folder (same file system for the rename); created by savefig with the
+    # umask's permissions (mkstemp would leave the final file readable by its owner only)
+    temporary = path.with_name(f".{path.stem}.{os.getpid()}.{secrets.token_hex(4)}.png.part")
     try:
         fig.savefig(temporary, format="png", dpi=dpi)
         os.replace(temporary, path)
