@@ -155,3 +155,11 @@ def test_default_install_depends_on_pypardiso_where_mkl_wheels_exist():
                                       ("darwin", "x86_64", True), ("linux", "aarch64", False),
                                       ("darwin", "arm64", False)]:
         assert marker.evaluate({"sys_platform": system, "platform_machine": machine}) is expected
+
+
+@pytest.mark.parametrize("name", BACKENDS)
+def test_empty_system_every_dof_prescribed(name):
+    empty = sp.csr_matrix((0, 0))
+    x = LinearSolver(name, symmetric=True).analyse(empty).factorize(empty).solve(np.zeros(0))
+    assert x.shape == (0,)
+    assert linsolve.solve(empty, np.zeros(0), name, symmetric=True).shape == (0,)

@@ -191,6 +191,8 @@ class LinearSolver:
         self._factorized_values: np.ndarray | None = None
         self._pardiso: _Pardiso | None = None
         self._permutation: np.ndarray | None = None
+        self._permuted = False
+        self.n = 0
 
     # ------------------------------------------------------------------ pattern
     def matches(self, indptr: np.ndarray, indices: np.ndarray) -> bool:
@@ -214,8 +216,9 @@ class LinearSolver:
         indptr = np.asarray(indptr, dtype=np.int64)
         indices = np.asarray(indices, dtype=np.int64)
         n = indptr.size - 1
-        if n < 1 or indices.size != indptr[-1] or (indices.size and (indices.min() < 0 or indices.max() >= n)):
-            raise ValueError("pattern must be a square CSR pattern (indptr of n+1 entries, indices in 0..n-1)")
+        if n < 0 or indices.size != indptr[-1] or (indices.size and (indices.min() < 0 or indices.max() >= n)):
+            raise ValueError("pattern must be a square CSR pattern (indptr of n+1 entries, indices in 0..n-1); "
+                             f"got {indptr.size} indptr entries and {indices.size} indices")
         if self.matches(indptr, indices):
             return self
         self._release()
@@ -263,7 +266,8 @@ class LinearSolver:
         if not np.all(np.isfinite(values)):
             raise np.linalg.LinAlgError("tangent matrix has non-finite entries")
         self._factorized_values = None
-        getattr(self, f"_factorize_{self.name}")(values)
+        if self.n > 0:  # an empty system (every dof prescribed) has nothing to factorise
+            getattr(self, f"_factorize_{self.name}")(values)
         self._factorized_values = values.copy()
         self.statistics.factorizations += 1
         return self
@@ -323,7 +327,9 @@ class LinearSolver:
         rhs = np.asarray(rhs, dtype=float)
         if rhs.shape[0] != self.n:
             raise ValueError(f"rhs must have {self.n} rows; got {rhs.shape}")
-        if self.name == "pardiso":
+        if self.n == 0:
+            x = np.zeros_like(rhs)
+        elif self.name == "pardiso":
             x = self._pardiso.call(33, self._data, *self._pardiso_pattern(), rhs=rhs)
         elif self.name == "scipy":
             x = self._factor.solve(rhs)
