@@ -135,3 +135,30 @@ def test_smoothed_bilayer_uses_the_library_law_with_the_tanh_switch():
     F = np.diag([1.0 + 1e-4, 1 / (1.0 + 1e-4), 1.0])[:, :, None]
     sharp = b14.bimodular_bilayer()[1][1]
     assert law.psi(F)[0] < sharp.psi(F)[0]  # just above λ = 1: the smoothed modulus is below μ+
+
+
+def test_figure_8_legend_sits_outside_the_data():
+    """Issue 12 item 7: the Fig. 8 legend covered the data; now it is a figure legend clear of both panels."""
+    import matplotlib.pyplot as plt
+
+    axes = figures.figure_8()
+    fig = axes[0].figure
+    fig.canvas.draw()
+    legend = fig.legends[0].get_window_extent()
+    assert not any(legend.overlaps(ax.get_window_extent()) for ax in axes)
+    plt.close(fig)
+
+
+def test_sliding_figure_defines_its_symbols():
+    """Issue 12 item 7: the sliding measure S (legend) and Λ1 (axis) are defined on the figure itself."""
+    import matplotlib.pyplot as plt
+
+    Y = np.linspace(0.0, 0.4, 5)
+    flat = {(1.0, 0.2): 1 + 0 * Y, (45.0, 0.2): 1 + 0 * Y}
+    study = {"Y": Y, "H": 0.4, "curvatures": (0.2,), "moduli": (1.0, 45.0), "direction": "WC", "profiles": flat,
+             "sliding": {(1.0, 0.2): 0.0, (45.0, 0.2): 0.0}}
+    axes = figures.figure_4_9_end_loading(study)
+    fig = axes[0].figure
+    assert "S = J(μS) − J(45 kPa)" in fig._suptitle.get_text() and "J = jump of Λ1" in fig._suptitle.get_text()
+    assert "Λ1 = √(U11² + U12²)" in axes[0].get_ylabel()
+    plt.close(fig)

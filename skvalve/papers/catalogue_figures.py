@@ -22,7 +22,7 @@ def group_figure(entries: Sequence[CatalogueEntry]):
     (dashed: a compressible law with free lateral stretch), or a fibre's axial force against its stretch."""
     first = entries[0]
     if not isinstance(first.law, Hyperelastic):  # 1-D fibre: force–stretch
-        fig, ax = plt.subplots(figsize=(6.4, 4.4))
+        fig, ax = plt.subplots(figsize=(6.4, 4.4), layout="constrained")
         for entry in entries:
             lam = np.linspace(*entry.stretch_range, 200)
             ax.plot(lam, entry.law.force(lam) * 1e9, label=entry.name)
@@ -30,7 +30,7 @@ def group_figure(entries: Sequence[CatalogueEntry]):
         ax.set(xlabel="fibre stretch λ", ylabel="axial force (nN)", title=first.paper)
         ax.legend(loc="upper left")
         return fig
-    fig, axes = plt.subplots(1, 2, figsize=(11.0, 4.8))
+    fig, axes = plt.subplots(1, 2, figsize=(11.0, 4.8), layout="constrained")
     for entry in entries:
         lam = np.linspace(*entry.stretch_range, 61)
         for ax, mode in zip(axes, (uniaxial, equibiaxial), strict=True):

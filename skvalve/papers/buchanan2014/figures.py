@@ -43,7 +43,8 @@ _INTERFACES = np.cumsum([f for _, f in TRILAYER_FRACTIONS])[:-1]  # 0.25, 0.55
 def _axes(axes, ncols: int, width: float, height: float = 4.2, sharey: bool = False):
     if axes is not None:
         return np.atleast_1d(axes)
-    return np.atleast_1d(plt.subplots(1, ncols, figsize=(width, height), sharey=sharey, squeeze=False)[1][0])
+    return np.atleast_1d(plt.subplots(1, ncols, figsize=(width, height), sharey=sharey, squeeze=False,
+                                      layout="constrained")[1][0])
 
 
 def _label_thickness(axes) -> None:
