@@ -6,6 +6,18 @@ instances (translation and rotation), all ``*Node`` blocks, element blocks, node
 ``generate``), element-face surfaces, sections, materials, amplitudes, boundary conditions, ``*Dsload``,
 contact pairs and general contact, ``*MPC``, rigid bodies, connectors, transforms and steps.
 
+Typical use (the numbering and the meaning of each field are documented in :mod:`.model`)::
+
+    model = read_model("Diseased_QuasiStatic.inp")
+    model.elements_by_type()                      # {'C3D8R': 18920, 'T3D2': 1783}
+    (truss,) = model.blocks_of_type("T3D2")       # labels, connectivity (global node indices), elset
+    annulus = model.node_set("Leaflet_Instance.Outer_Annular_Nodes").indices
+    model.node_indices("Leaflet_Instance.12")     # a node of an instance, as the file names it
+    area = [s.area for s in model.sections if s.elset.endswith("Chordae")]
+    ogden = model.material("Anterior_Chordae").option("hyperelastic").data
+    (step,) = model.steps                         # .boundary_conditions, .distributed_loads, .contact_pairs
+    model.ignored                                 # what the implicit model does not use, with file lines
+
 Modules: :mod:`.lexer` (cards, strict numbers, ``*Include``), :mod:`.model` (the dataclasses),
 :mod:`.materials`, :mod:`.mesh` and :mod:`.mesh_cards` (mesh keywords), :mod:`.step_cards` (history and
 constraint keywords), :mod:`.reader` (dispatch and assembly).

@@ -272,8 +272,8 @@ def read_procedure(card: Card, state: ParseState) -> None:
     if step.procedure is not None:
         raise card.error(f"step {step.name!r} already has the procedure *{step.procedure}")
     step.procedure = " ".join([card.keyword, *card.flags])
-    fields = [f for line in card.data for f in split_fields(line.text)]
-    step.procedure_data = [parse_float(f, card, card.data[0].location) if f else None for f in fields]
+    step.procedure_data = [parse_float(f, card, line.location) if f else None
+                           for line in card.data for f in split_fields(line.text)]
 
 
 HISTORY_HANDLERS = {
