@@ -17,9 +17,10 @@ Backends, fastest first:
   triangle with symmetric Bunch–Kaufman pivoting (matrix type −2), about a third faster than the
   general LU (type 11) that a non-symmetric tangent (follower pressure) needs.
 * ``"umfpack"`` — ``scikit-umfpack`` when installed.
-* ``"scipy"`` — SciPy's SuperLU, always available, much slower on large 3D problems. The column
-  permutation (COLAMD) of the first factorisation is kept and reused with ``permc_spec="NATURAL"``
-  on the permuted matrix, the SuperLU analogue of keeping the analysis.
+* ``"scipy"`` — SciPy's SuperLU, always available, much slower on large 3D problems. The
+  fill-reducing ordering of the first factorisation (minimum degree on :math:`A^T + A` when
+  symmetric, COLAMD otherwise) is kept and reused with ``permc_spec="NATURAL"`` on the permuted
+  matrix (:math:`PAP^T`, resp. :math:`AP^T`), the SuperLU analogue of keeping the analysis.
 
 Choosing: ``solver=None`` takes the fastest available backend and warns once per process when
 that is SciPy; an explicitly requested backend that is not installed raises
@@ -301,16 +302,20 @@ class LinearSolver:
 
     def _factorize_scipy(self, values: np.ndarray) -> None:
         A = self._matrix(values)
+        # symmetric: minimum degree on A^T + A (less fill for FE matrices); else COLAMD on the columns
+        spec = "MMD_AT_PLUS_A" if self.symmetric else "COLAMD"
         with warnings.catch_warnings():
             warnings.simplefilter("error", spla.MatrixRankWarning)
             try:
                 if self._permutation is None:
-                    self._factor = spla.splu(A, permc_spec="COLAMD")
+                    self._factor = spla.splu(A, permc_spec=spec)
                     self._permutation = self._factor.perm_c.copy()
                     self._permuted = False
                     self.statistics.analyses += 1
-                else:  # the kept column ordering: factorise A[:, perm] in its natural order
-                    self._factor = spla.splu(A[:, self._permutation], permc_spec="NATURAL")
+                else:  # the kept ordering, applied to the columns (and rows when symmetric), natural order
+                    perm = self._permutation
+                    self._factor = spla.splu(A[perm][:, perm] if self.symmetric else A[:, perm],
+                                             permc_spec="NATURAL")
                     self._permuted = True
             except (RuntimeError, spla.MatrixRankWarning) as err:
                 raise np.linalg.LinAlgError(f"singular tangent matrix ({err})") from err
@@ -332,10 +337,13 @@ class LinearSolver:
         elif self.name == "pardiso":
             x = self._pardiso.call(33, self._data, *self._pardiso_pattern(), rhs=rhs)
         elif self.name == "scipy":
-            x = self._factor.solve(rhs)
-            if self._permuted:  # A[:, perm] y = rhs  =>  x[perm] = y
-                y, x = x, np.empty_like(x)
-                x[self._permutation] = y
+            perm = self._permutation
+            if not self._permuted:
+                x = self._factor.solve(rhs)
+            else:  # (P A P^T)(P x) = P rhs, or A P^T (P x) = rhs: x[perm] = y
+                y = self._factor.solve(rhs[perm] if self.symmetric else rhs)
+                x = np.empty_like(y)
+                x[perm] = y
         else:  # pragma: no cover - optional package
             x = spla.spsolve(self._factor, rhs, use_umfpack=True)
         self.statistics.solves += 1
