@@ -77,13 +77,13 @@ def _summary(rows: list[Row]) -> str:
 
 def _cmd_reproduce(args: argparse.Namespace) -> int:
     paper = PAPERS[args.paper]
-    out = Path(args.out)
-    if problem := check_out(out):
-        return _error(problem)
     reproduce = _load_reproduce(paper)
     if reproduce is None:
         return _error(f"reproduce {paper.key} is not available yet. When it is, it will compute: {paper.plan} "
                       f"({paper.citation}).")
+    out = Path(args.out)
+    if problem := check_out(out):
+        return _error(problem)
     rows: list[Row] = []
     written: list[Path] = []
     start = time.perf_counter()

@@ -94,7 +94,8 @@ def test_interrupt_reports_what_was_finished(monkeypatch, tmp_path, capsys):
 @pytest.mark.parametrize("paper", ["thomas2019", "mathur2022"])
 def test_a_paper_not_available_yet_says_what_it_will_compute(monkeypatch, tmp_path, capsys, paper):
     monkeypatch.setitem(sys.modules, f"skvalve.papers.{paper}.reproduce", None)  # the module does not exist
-    assert main(["reproduce", paper, "--out", str(tmp_path)]) == 2
+    assert main(["reproduce", paper, "--out", str(tmp_path / "out")]) == 2
+    assert not (tmp_path / "out").exists()
     err = capsys.readouterr().err
     assert "not available yet" in err and "will compute" in err
     assert ("Table 3" in err) if paper == "mathur2022" else ("RVE" in err)
