@@ -10,6 +10,7 @@ import time
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 from skvalve.io.abaqus import read_model, trivalve_inputs
 
@@ -84,6 +85,16 @@ def test_repairs_keep_their_constraints():
     for number, name in enumerate(["Clip-1-1", "Clip-1-2", "Clip-2-1", "Clip-2-2"], start=1):
         point = clipping.nodes[clipping.node_indices(str(number))[0]]
         assert point == pytest.approx(clipping.instances[name.upper()].translation)
+
+
+def test_clip_arms_are_placed_1_4_mm_apart():
+    """Paper section 2.11: the two arms of each clip sit 1.4 mm apart. The clip part is instanced four times
+    with a translation and a rotation, so this checks the instance transform (and its sign convention)."""
+    model, _ = _model("1.0-clipping")
+    for first, second in (("Clip-1-1", "Clip-1-2"), ("Clip-2-1", "Clip-2-2")):
+        a = model.nodes[model.node_set(f"{first}.Clip").indices]
+        b = model.nodes[model.node_set(f"{second}.Clip").indices]
+        assert cKDTree(b).query(a)[0].min() == pytest.approx(1.4, abs=0.01)
 
 
 def test_ignored_keywords_are_listed():
