@@ -87,6 +87,14 @@ def test_repairs_keep_their_constraints():
         assert point == pytest.approx(clipping.instances[name.upper()].translation)
 
 
+def test_chordae_sections_match_the_paper_diameters():
+    """Paper section 2.8: chordae diameters 0.65 (anterior), 0.64 (posterior), 0.71 mm (septal)."""
+    model, _ = _model("1.0-diseased")
+    areas = {s.material: s.area for s in model.sections if s.area is not None}
+    for chord, diameter in (("Anterior", 0.65), ("Posterior", 0.64), ("Septal", 0.71)):
+        assert np.sqrt(4 * areas[f"{chord}_Chordae"] / np.pi) == pytest.approx(diameter, abs=0.005)
+
+
 def test_clip_arms_are_placed_1_4_mm_apart():
     """Paper section 2.11: the two arms of each clip sit 1.4 mm apart. The clip part is instanced four times
     with a translation and a rotation, so this checks the instance transform (and its sign convention)."""

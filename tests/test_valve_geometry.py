@@ -11,6 +11,7 @@ import logging
 import numpy as np
 import pytest
 from scipy import integrate
+from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from skvalve.io.abaqus import read_model, trivalve_inputs
@@ -175,6 +176,11 @@ def test_trivalve_diseased_orifice_and_leaflets():
         mean = 0.5 * (leaflet["atrial"] + leaflet["ventricular"])
         assert leaflet["mid"] == pytest.approx(mean, rel=2e-3)
         assert leaflet["atrial"] < leaflet["mid"] < leaflet["ventricular"]
+    # paper section 2.8: leaflets 0.78 mm thick (ventricular to atrial face of each brick column)
+    for surface in surfaces.values():
+        ventricular = model.nodes[surface.ventricular].mean(axis=1)
+        atrial = model.nodes[surface.atrial].mean(axis=1)
+        assert np.median(cKDTree(atrial).query(ventricular)[0]) == pytest.approx(0.78, abs=0.01)
     for name, faces in areas.centre_faces.items():
         assert areas.centre_area[name] == pytest.approx(0.1 * areas.leaflet[name]["mid"], rel=0.05)
         assert len(faces) > 10
