@@ -12,7 +12,7 @@ from skvalve.papers.buchanan2014 import data, figures
 from skvalve.papers.buchanan2014 import fe as b14_fe
 from skvalve.papers.buchanan2014 import models as b14
 from skvalve.papers.buchanan2014 import reproduce as b14_reproduce
-from skvalve.papers.buchanan2014.rows import analytic_rows
+from skvalve.papers.buchanan2014.rows import analytic_rows, closed_form_rows
 from skvalve.papers.plotting import DPI, MIN_WIDTH_IN
 from skvalve.papers.table import Status
 
@@ -78,7 +78,7 @@ def test_ogden_family_normalisation_and_alpha_two_curve():
 
 
 def test_analytic_rows_and_figures(tmp_path):
-    rows = analytic_rows()
+    rows = analytic_rows() + closed_form_rows()
     names = [r.quantity for r in rows]
     assert len(names) == len(set(names))
     assert all(r.ok for r in rows if r.quantity.startswith("[exact]") or r.quantity.startswith("Table 3"))

@@ -22,6 +22,7 @@ from .figures import ANALYTIC_FIGURES, figure_4_9_end_loading, figure_7, figure_
 from .rows import (
     analytic_rows,
     bimodular_fe_rows,
+    closed_form_rows,
     fe_convergence_rows,
     sliding_rows,
     warping_rows,
@@ -42,6 +43,7 @@ def reproduce(out: Path | None = None, full: bool = False) -> Iterator[Row | Sta
     out = None if out is None else Path(out)
     yield Stage("Rivlin pure bending: Fig. 8, Table 2, Sect. 3.3, Tables 1/3, closed forms")
     yield from analytic_rows()
+    yield from closed_form_rows()
     if out is not None:
         for name, draw in ANALYTIC_FIGURES:
             yield Written(write_figure(out, name, draw))
