@@ -221,6 +221,14 @@ def test_redefined_element_keeps_last_definition_with_a_warning(tmp_path):
     assert model.warnings and model.warnings[0].location.line == 6
 
 
+def test_node_set_of_an_element_set(tmp_path):
+    path = tmp_path / "nodes_of.inp"
+    path.write_text("*Node\n1, 0, 0, 0\n2, 1, 0, 0\n3, 2, 0, 0\n4, 3, 0, 0\n*Element, type=T3D2, elset=E\n"
+                    "7, 2, 3\n8, 3, 4\n*Nset, nset=N, elset=E\n")
+    model = read_model(path)
+    assert sorted(model.node_labels[model.node_set("n").indices]) == [2, 3, 4]
+
+
 def test_elements_may_be_named_by_a_set_before_they_are_defined(tmp_path):
     path = tmp_path / "forward.inp"
     path.write_text("*Node\n1, 0, 0, 0\n2, 1, 0, 0\n*Elset, elset=W\n 1,\n*Element, type=CONN3D2\n1, 1, 2\n")
@@ -252,6 +260,7 @@ SMALL_BAD = {
     "*Node, system=C\n1, 1, 0, 0\n": "SYSTEM=R",
     "*Node\n1,0,0,0\n*Boundary\n1, 9\n": "degree of freedom 9",
     "*Material, name=M\n\x00": "NUL",
+    "*Node, input=nodes.inp\n": "INPUT=",
 }
 
 

@@ -166,6 +166,10 @@ def read_set(card: Card, scope: MeshScope) -> None:
     if instance is not None and not scope.instances:
         raise card.error("INSTANCE= is only allowed in the assembly")
     chunks: list[np.ndarray] = [np.empty(0, np.int64)]
+    if nodes and card.parameters.get("elset"):
+        if card.data or instance is not None:
+            raise card.error("*Nset with ELSET= takes no data lines and no INSTANCE=")
+        chunks.append(_element_nodes(resolve_elements(card.parameters["elset"], scope, card, card.location), scope))
     labels: list[int] = []
     label_lines: list[Location] = []
     for line in card.data:
@@ -191,6 +195,13 @@ def read_set(card: Card, scope: MeshScope) -> None:
         scope.add_to_node_set(name, indices, card.location)
     else:
         scope.add_to_element_set(name, indices, card.location)
+
+
+def _element_nodes(elements: np.ndarray, scope: MeshScope) -> np.ndarray:
+    """Nodes (scope indices) of the given elements."""
+    found = [block.connectivity[elements[(elements >= block.offset) & (elements < block.offset + len(block.labels))]
+                                - block.offset].ravel() for block in scope.blocks]
+    return np.unique(np.concatenate([np.empty(0, np.int64), *found]))
 
 
 def _labels_to_indices(labels: np.ndarray, lines: list[Location], scope: MeshScope, card: Card, nodes: bool,

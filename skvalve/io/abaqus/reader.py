@@ -172,6 +172,8 @@ def _dispatch(card: Card, state: ParseState) -> None:
         raise card.error("material option outside a *Material")
     if card.keyword not in ("friction", "surface behavior"):
         state.interaction = None
+    if "input" in card.parameters:
+        raise card.error("data read from another file (INPUT=) is only supported through *Include")
     if card.keyword in IGNORED_KEYWORDS:
         state.ignored.append(IgnoredKeyword(card.title, card.location, IGNORED_KEYWORDS[card.keyword]))
         return
