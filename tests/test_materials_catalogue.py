@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import functools
+
 import matplotlib.image
 import numpy as np
 import pytest
@@ -17,8 +19,13 @@ TRIVALVE = trivalve_input()
 needs_trivalve = pytest.mark.skipif(TRIVALVE is None, reason="Texas TriValve input (../shared/data) not present")
 
 
+@functools.cache
+def _catalogue():
+    return catalogue()  # reads the TriValve input when present: once per test session
+
+
 def _entry(name_part: str):
-    matches = [e for e in catalogue() if name_part in e.name]
+    matches = [e for e in _catalogue() if name_part in e.name]
     assert len(matches) == 1, name_part
     return matches[0]
 
@@ -50,10 +57,10 @@ def test_thomas2019_matrix_has_the_small_strain_youngs_modulus():
 def test_texas_trivalve_leaflets_match_the_papers_bulk_modulus_and_are_credited():
     """mathur2022 Sect. 2.8: the file's D gives the bulk modulus 99.67 kPa and, with the small-strain shear
     modulus μ = c0 of Eq. 1 (the exponential term has zero slope at Ī1 = 3), Poisson's ratio 0.495."""
-    for entry in catalogue():
+    for entry in _catalogue():
         if entry.paper == "mathur2022":
             assert CREDIT in entry.source and "CC BY-NC-SA 4.0" in entry.source
-    leaflets = [e for e in catalogue() if e.paper == "mathur2022" and "leaflet" in e.name]
+    leaflets = [e for e in _catalogue() if e.paper == "mathur2022" and "leaflet" in e.name]
     assert len(leaflets) == 3
     for entry in leaflets:
         assert entry.law.bulk_modulus == pytest.approx(BULK_MODULUS_KPA, rel=1e-3)
@@ -72,7 +79,7 @@ def test_cli_prints_without_plotting(tmp_path, capsys):
 
 def test_cli_writes_one_readable_figure_per_group(tmp_path):
     assert cli_main(["materials", "--out", str(tmp_path)]) == 0
-    groups = {e.group for e in catalogue()}
+    groups = {e.group for e in _catalogue()}
     written = {p.stem for p in tmp_path.glob("*.png")}
     assert written == groups
     for path in tmp_path.glob("*.png"):
