@@ -7,11 +7,14 @@ from skvalve.networks import library
 from skvalve.networks.generate import clip_to_unit_cube, delaunay_fibers, generate, prune
 from skvalve.networks.network import Network
 from skvalve.networks.orientation import network_alpha_mu
+from skvalve.papers.thomas2019.data import NETWORK
+
+N_FIBERS = NETWORK.fibers_per_rve  # thomas2019 §2.5: ~450 fibers per RVE
 
 
 @pytest.fixture(scope="module")
 def networks():
-    return {(a, m): generate(a, m, seed=1) for a, m in [(27.0, 0.0), (41.0, 60.0), (28.0, -45.0)]}
+    return {(a, m): generate(a, m, n_fibers=N_FIBERS, seed=1) for a, m in [(27.0, 0.0), (41.0, 60.0), (28.0, -45.0)]}
 
 
 def test_targets_are_met(networks):
@@ -48,24 +51,24 @@ def test_seeded_and_deterministic():
 
 
 def test_random_target_and_bad_input():
-    net = generate(0.0, 0.0, seed=2)  # α ≈ 0 is below the sampling noise: sub-seeds are retried
+    net = generate(0.0, 0.0, n_fibers=N_FIBERS, seed=2)  # α ≈ 0 is below the sampling noise: sub-seeds are retried
     assert network_alpha_mu(net)[0] <= 3.0
     with pytest.raises(ValueError, match="alpha"):
-        generate(120.0, 0.0)
+        generate(120.0, 0.0, n_fibers=N_FIBERS)
     with pytest.raises(ValueError, match="n_fibers"):
         generate(30.0, 0.0, n_fibers=5)
     with pytest.raises(ValueError, match="n_fibers"):
         generate(30.0, 0.0, n_fibers=200.5)
     for seed in (None, -1, 1.5):
         with pytest.raises(ValueError, match="seed"):
-            generate(30.0, 0.0, seed=seed)
+            generate(30.0, 0.0, n_fibers=N_FIBERS, seed=seed)
     # a negative tolerance used to run all 200 sub-seeds before a RuntimeError
     with pytest.raises(ValueError, match="alpha_tol"):
-        generate(30.0, 0.0, alpha_tol=-1.0)
+        generate(30.0, 0.0, n_fibers=N_FIBERS, alpha_tol=-1.0)
     with pytest.raises(ValueError, match="mu_tol"):
-        generate(30.0, 0.0, mu_tol=0.0)
+        generate(30.0, 0.0, n_fibers=N_FIBERS, mu_tol=0.0)
     with pytest.raises(ValueError, match="mu"):
-        generate(30.0, np.nan)
+        generate(30.0, np.nan, n_fibers=N_FIBERS)
 
 
 def test_clipping_by_hand():

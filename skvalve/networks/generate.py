@@ -44,6 +44,24 @@ MAX_STRETCH = 8.0
 # the cut edges crossing the faces); calibrated once on random (s = 1) networks.
 FIBERS_PER_POINT = 11.5
 DENSITY_HEADROOM = 1.5  # extra points drawn so that the density can be corrected upwards
+# bounds on a request, so that a huge one fails at once instead of after minutes of Delaunay
+# work or gigabytes of points: ~8.4 n_fibers points are drawn per attempt
+MAX_FIBERS = 20_000
+MAX_ATTEMPTS = 10_000
+
+
+def _is_integer(value) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+
+
+def check_request(n_fibers: int, seed: int, max_attempts: int = 1) -> None:
+    """Raise ValueError naming the parameter if a generation request is malformed or too big."""
+    if not _is_integer(n_fibers) or not 20 <= n_fibers <= MAX_FIBERS:
+        raise ValueError(f"generate: n_fibers must be an integer in [20, {MAX_FIBERS}], got {n_fibers!r}")
+    if not _is_integer(seed) or seed < 0:
+        raise ValueError(f"generate: seed must be a non-negative integer, got {seed!r}")
+    if not _is_integer(max_attempts) or not 1 <= max_attempts <= MAX_ATTEMPTS:
+        raise ValueError(f"generate: max_attempts must be an integer in [1, {MAX_ATTEMPTS}], got {max_attempts!r}")
 
 
 def random_points(n_points: int, rng: np.random.Generator) -> np.ndarray:
@@ -147,7 +165,7 @@ def _candidate(points, marks, stretch, mu_deg, density_factor=1.0) -> Network:
 def generate(
     alpha: float,
     mu: float,
-    n_fibers: int = 450,
+    n_fibers: int,
     seed: int = 0,
     alpha_tol: float = 3.0,
     mu_tol: float = 5.0,
@@ -157,7 +175,12 @@ def generate(
 
     alpha : target anisotropy index in percent (Eq. 2), 0 ≤ alpha < 95.
     mu : target mean fiber direction in degrees (Eq. 3), measured from x towards y.
-    n_fibers : approximate number of fibers in the RVE (the paper uses ~450).
+    n_fibers : approximate number of fibers in the RVE, 20 ≤ n_fibers ≤ ``MAX_FIBERS``
+        (thomas2019 uses ~450: ``skvalve.papers.thomas2019.data.NETWORK.fibers_per_rve``).
+    seed : non-negative integer; the result is a deterministic function of all arguments.
+    max_attempts : sub-seeds tried, 1 ≤ max_attempts ≤ ``MAX_ATTEMPTS``.
+    ``meta`` holds the targets and the achieved α, μ (float), stretch, rotation (float), seed,
+    attempt and pruned_fibers (int).
     The result satisfies |α − alpha| ≤ alpha_tol and, for alpha ≥ 10, |μ − mu| ≤ mu_tol
     (axially, modulo 180°); RuntimeError if ``max_attempts`` sub-seeds all fail.
     """
@@ -165,15 +188,10 @@ def generate(
         raise ValueError(f"generate: alpha must be in [0, 95) percent, got {alpha}")
     if not np.isfinite(mu):
         raise ValueError(f"generate: mu must be finite, got {mu}")
-    if isinstance(n_fibers, bool) or not isinstance(n_fibers, (int, np.integer)) or n_fibers < 20:
-        raise ValueError(f"generate: n_fibers must be an integer >= 20, got {n_fibers!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ValueError(f"generate: seed must be a non-negative integer, got {seed!r}")
+    check_request(n_fibers, seed, max_attempts)
     for name, value in (("alpha_tol", alpha_tol), ("mu_tol", mu_tol)):
         if not (np.isfinite(value) and value > 0):
             raise ValueError(f"generate: {name} must be positive and finite, got {value!r}")
-    if int(max_attempts) < 1:
-        raise ValueError(f"generate: max_attempts must be >= 1, got {max_attempts!r}")
     density = n_fibers / FIBERS_PER_POINT  # interior points per unit volume in the final cube
     n_max = int(round(8.0 * density * MAX_STRETCH * DENSITY_HEADROOM))
     check_mu = alpha >= 10.0
@@ -205,12 +223,13 @@ def generate(
             network.meta.update(
                 alpha_target=float(alpha),
                 mu_target=float(mu),
-                alpha=a,
-                mu=m,
-                stretch=stretch,
-                rotation=rotation,
-                seed=seed,
-                attempt=attempt,
+                alpha=float(a),
+                mu=float(m),
+                stretch=float(stretch),
+                rotation=float(rotation),
+                seed=int(seed),
+                attempt=int(attempt),
+                pruned_fibers=int(network.meta["pruned_fibers"]),
             )
             return network
     raise RuntimeError(

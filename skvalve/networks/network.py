@@ -9,11 +9,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import BinaryIO
 
 import numpy as np
 
 FACE_NAMES = ("-x", "+x", "-y", "+y", "-z", "+z")
 INTERIOR = -1
+
+
+def _text(value, kind: str) -> str:
+    """Metadata value as text that parses back exactly (repr keeps every bit of a float)."""
+    return repr(float(value)) if kind == "float" else str(int(value)) if kind == "int" else str(value)
 
 
 @dataclass
@@ -73,27 +79,45 @@ class Network:
         """Dimensionless total fiber length L of Eqs. 6–8."""
         return float(self.fiber_lengths().sum())
 
-    def save(self, path: str | Path) -> None:
-        """Store as a compressed ``.npz`` (meta values must be numbers or strings)."""
-        meta_keys = np.array(list(self.meta.keys()), dtype=str)
-        meta_values = np.array([str(v) for v in self.meta.values()], dtype=str)
+    def save(self, path: str | Path | BinaryIO) -> None:
+        """Store as a compressed ``.npz`` (a path or a binary stream); meta values must be bool,
+        int, float or str and come back with their types from :meth:`load`."""
+        kinds = {bool: "bool", int: "int", float: "float", str: "str"}
+        meta_types = []
+        for key, value in self.meta.items():
+            kind = next((name for cls, name in kinds.items() if type(value) is cls), None)
+            if kind is None:
+                kind = "int" if isinstance(value, np.integer) else "float" if isinstance(value, np.floating) else None
+            if kind is None:
+                raise TypeError(f"Network.save: meta[{key!r}] must be bool, int, float or str, got {type(value)}")
+            meta_types.append(kind)
         np.savez_compressed(
             path,
             nodes=self.nodes,
             fibers=self.fibers,
             boundary=self.boundary,
             face=self.face,
-            meta_keys=meta_keys,
-            meta_values=meta_values,
+            meta_keys=np.array(list(self.meta.keys()), dtype=str),
+            meta_values=np.array([_text(v, t) for v, t in zip(self.meta.values(), meta_types, strict=True)], dtype=str),
+            meta_types=np.array(meta_types, dtype=str),
         )
 
     @classmethod
     def load(cls, path: str | Path) -> Network:
-        with np.load(path) as data:
+        """Read a file written by :meth:`save` (never unpickles: ``allow_pickle=False``).
+
+        Raises ValueError/KeyError/OSError (or zipfile.BadZipFile, EOFError) for a file that is
+        not such a network.
+        """
+        parse = {"bool": lambda v: v == "True", "int": int, "float": float, "str": str}
+        with np.load(path, allow_pickle=False) as data:
+            if not hasattr(data, "files"):
+                raise ValueError(f"{path}: not an .npz archive")
+            keys, values = data["meta_keys"], data["meta_values"]
+            types = data["meta_types"] if "meta_types" in data.files else np.array(["float"] * len(keys))
             meta = {}
-            for key, value in zip(data["meta_keys"], data["meta_values"], strict=True):
-                try:
-                    meta[str(key)] = float(value)
-                except ValueError:
-                    meta[str(key)] = str(value)
+            for key, value, kind in zip(keys, values, types, strict=True):
+                if str(kind) not in parse:
+                    raise ValueError(f"{path}: unknown metadata type {kind!r}")
+                meta[str(key)] = parse[str(kind)](str(value))
             return cls(data["nodes"], data["fibers"], data["boundary"], data["face"], meta)

@@ -54,7 +54,10 @@ import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numba
 import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from skvalve.materials.exponential_fiber import ExponentialFiber
 from skvalve.networks import rve_kernels as kernels
@@ -83,6 +86,10 @@ class RVEResult:
     rve_edge_length: float  # γ of Eq. 7 (m)
 
 
+# RVE chunks per numba thread in a batch solve: load balance vs. one workspace per chunk
+CHUNKS_PER_THREAD = 4
+
+
 def _check_F(F: np.ndarray, where: str) -> np.ndarray:
     F = np.asarray(F, dtype=float)
     if F.shape[-2:] != (3, 3) or not np.all(np.isfinite(F)):
@@ -109,6 +116,33 @@ def _scale(network: Network, fiber: ExponentialFiber, psi: float, diameter: floa
     return psi * fiber.axial_rigidity / (length * area), math.sqrt(length * area / psi)
 
 
+def interior_numbering(network: Network) -> tuple[np.ndarray, np.ndarray]:
+    """Interior DOF numbering of a network and the envelope of its stiffness.
+
+    Returns ``dof`` (n_nodes,): interior node index in reverse Cuthill–McKee order of the
+    interior–interior fiber graph (−1 on the boundary), and ``first`` (3 n_free,): the column
+    where each row of K's lower envelope starts (``dense_cholesky``).  Computed once per network.
+    """
+    interior = ~network.boundary
+    n_free = int(interior.sum())
+    local = np.full(network.n_nodes, -1, dtype=np.int64)
+    local[interior] = np.arange(n_free)
+    if n_free == 0:
+        return local, np.zeros(0, dtype=np.int64)
+    ends = local[network.fibers]
+    pairs = ends[(ends[:, 0] >= 0) & (ends[:, 1] >= 0)]
+    graph = csr_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n_free, n_free))
+    order = reverse_cuthill_mckee((graph + graph.T).tocsr(), symmetric_mode=True)
+    new_index = np.empty(n_free, dtype=np.int64)
+    new_index[order] = np.arange(n_free)
+    dof = np.full(network.n_nodes, -1, dtype=np.int64)
+    dof[interior] = new_index
+    first_node = np.arange(n_free)
+    renumbered = new_index[pairs] if len(pairs) else np.zeros((0, 2), dtype=np.int64)
+    np.minimum.at(first_node, renumbered.max(axis=1), renumbered.min(axis=1))
+    return dof, np.repeat(3 * first_node, 3).astype(np.int64)
+
+
 class RVEBatch:
     """Several networks packed for the parallel kernel, with their warm-start states.
 
@@ -120,8 +154,8 @@ class RVEBatch:
         self,
         networks: Sequence[Network],
         fiber: ExponentialFiber,
-        psi: float = 0.43,
-        fiber_diameter: float | None = 450e-9,
+        psi: float,
+        fiber_diameter: float | None,
         tol: float = 1e-10,
         max_iter: int = 30,
     ) -> None:
@@ -148,12 +182,12 @@ class RVEBatch:
         self.rest_length = np.concatenate([net.fiber_lengths() for net in self.networks])
         if np.any(self.rest_length <= 0):
             raise ValueError("RVEBatch: a network has a fiber of zero length")
-        dofs = []
+        numbering: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # once per distinct network
         for net in self.networks:
-            dof = np.full(net.n_nodes, -1, dtype=np.int64)
-            dof[~net.boundary] = np.arange((~net.boundary).sum())
-            dofs.append(dof)
-        self.dof = np.concatenate(dofs)
+            if id(net) not in numbering:
+                numbering[id(net)] = interior_numbering(net)
+        self.dof = np.concatenate([numbering[id(net)][0] for net in self.networks])
+        self.first = np.concatenate([numbering[id(net)][1] for net in self.networks])
         batch = len(self.networks)
         self.positions = self.X.copy()
         self.F_state = np.tile(np.eye(3), (batch, 1, 1))
@@ -202,6 +236,7 @@ class RVEBatch:
         )
         if batch == 1:  # serial kernel: no parallel compilation for single solves
             m1 = self.fiber_start[1]
+            workspace = kernels.workspace(3 * self.n_free[0], m1, self.node_start[1])
             out["status"][0], out["iterations"][0], out["residual"][0] = kernels.solve_one(
                 *self._network_arrays(0),
                 x_previous,
@@ -216,6 +251,7 @@ class RVEBatch:
                 out["cauchy"][0],
                 out["tangent"][0],
                 out["stretch"][:m1],
+                workspace,
             )
         else:
             kernels.solve_many(
@@ -226,6 +262,7 @@ class RVEBatch:
                 self.fibers,
                 self.rest_length,
                 self.dof,
+                self.first,
                 self.n_free,
                 x_previous,
                 F_previous,
@@ -242,6 +279,7 @@ class RVEBatch:
                 out["status"],
                 out["iterations"],
                 out["residual"],
+                min(batch, CHUNKS_PER_THREAD * numba.get_num_threads()),
             )
         for r in np.flatnonzero(out["status"] != kernels.CONVERGED):
             self._substep(r, F[r], x_previous, F_previous, sensitivity, out)
@@ -272,7 +310,15 @@ class RVEBatch:
     def _network_arrays(self, r: int) -> tuple:
         n0, n1 = self.node_start[r], self.node_start[r + 1]
         m0, m1 = self.fiber_start[r], self.fiber_start[r + 1]
-        return (self.X[n0:n1], self.fibers[m0:m1], self.rest_length[m0:m1], self.dof[n0:n1], self.n_free[r])
+        s0, s1 = self.free_start[r], self.free_start[r + 1]
+        return (
+            self.X[n0:n1],
+            self.fibers[m0:m1],
+            self.rest_length[m0:m1],
+            self.dof[n0:n1],
+            self.first[s0:s1],
+            self.n_free[r],
+        )
 
     def _substep(self, r, F_target, x_previous, F_previous, sensitivity, out) -> None:
         """Retry a failed RVE from its start state in 2, 4, ..., 64 increments."""
@@ -287,6 +333,7 @@ class RVEBatch:
         m0, m1 = self.fiber_start[r], self.fiber_start[r + 1]
         s0, s1 = self.free_start[r], self.free_start[r + 1]
         args = self._network_arrays(r)
+        workspace = kernels.workspace(s1 - s0, m1 - m0, n1 - n0)
         for n_steps in (2, 4, 8, 16, 32, 64):
             x_start = x_previous[n0:n1].copy()
             F_start = F_previous[r].copy()
@@ -308,6 +355,7 @@ class RVEBatch:
                     out["cauchy"][r],
                     out["tangent"][r],
                     out["stretch"][m0:m1],
+                    workspace,
                 )
                 if status not in (kernels.CONVERGED, kernels.INDEFINITE):
                     break
@@ -327,8 +375,8 @@ def solve_rve(
     network: Network,
     F: np.ndarray,
     fiber: ExponentialFiber,
-    psi: float = 0.43,
-    fiber_diameter: float | None = 450e-9,
+    psi: float,
+    fiber_diameter: float | None,
     state: RVEState | None = None,
     tol: float = 1e-10,
     max_iter: int = 30,
@@ -350,8 +398,8 @@ def solve_rve_batch(
     networks: Sequence[Network],
     F: np.ndarray,
     fiber: ExponentialFiber,
-    psi: float = 0.43,
-    fiber_diameter: float | None = 450e-9,
+    psi: float,
+    fiber_diameter: float | None,
     states: Sequence[RVEState | None] | None = None,
     tol: float = 1e-10,
 ) -> list[RVEResult]:
@@ -370,8 +418,8 @@ def boundary_stress(
     network: Network,
     result: RVEResult,
     fiber: ExponentialFiber,
-    psi: float = 0.43,
-    fiber_diameter: float | None = 450e-9,
+    psi: float,
+    fiber_diameter: float | None,
 ) -> np.ndarray:
     """Eq. 8 literally: ψ/(L A_f V) Σ_boundary x ⊗ f, f the reaction at each boundary node."""
     x = result.deformed_nodes

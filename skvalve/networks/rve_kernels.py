@@ -1,15 +1,18 @@
 """Numba kernels of the RVE force balance (Thomas et al. 2019 section 2.4; see ``rve.py``).
 
-Unknowns are the positions of the interior cross-links, 3 per node; forces are divided by
-E_f A_f (which cancels from the balance).  For a fiber k from node a to node b with
-d = x_b − x_a, ℓ = |d|, e = d/ℓ, λ = ℓ/L0 and force f(λ):
+Unknowns are the positions of the interior cross-links, 3 per node, numbered in the
+bandwidth-reducing order chosen by ``rve.py`` (``dof``); forces are divided by E_f A_f (which
+cancels from the balance).  For a fiber k from node a to node b with d = x_b − x_a, ℓ = |d|,
+e = d/ℓ, λ = ℓ/L0 and force f(λ):
 
     residual:  r_a −= f e,   r_b += f e                      (r = ∂Π/∂x, Π = Σ L0 W(λ))
     stiffness: K_k = (f'(λ)/L0) e⊗e + (f/ℓ)(I − e⊗e),  added as [[K_k, −K_k], [−K_k, K_k]].
 
-K restricted to interior nodes is factorised by the dense Cholesky of ``dense_cholesky`` (no LAPACK
-threads inside the numba ``prange`` over RVEs); the same factor gives the Newton steps, the
-node sensitivities dx/dF (9 right-hand sides) and with them the consistent tangent.
+Only the lower envelope of K (rows from ``first[i]``) is assembled and factorised
+(``dense_cholesky``); the same factor gives the Newton steps, the node sensitivities dx/dF
+(9 right-hand sides in one blocked solve) and with them the consistent tangent.  The last
+assembly stores f, f'/L0 and ℓ per fiber, which the sensitivity and stress passes reuse.
+Work arrays are allocated once per chunk of RVEs (``workspace``), not per solve.
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ import numpy as np
 from numba import njit, prange
 
 from skvalve.materials.exponential_fiber import normalized_energy, normalized_force_stiffness
-from skvalve.networks.dense_cholesky import cholesky_solve, factor_with_shift
+from skvalve.networks.dense_cholesky import FAST, cholesky_solve, cholesky_solve_vector, factor_with_shift
 
 # status codes of ``solve_network``
 CONVERGED, NOT_CONVERGED, INDEFINITE, COLLAPSED = 0, 1, 2, 3
@@ -31,18 +34,38 @@ CONVERGED, NOT_CONVERGED, INDEFINITE, COLLAPSED = 0, 1, 2, 3
 ROUNDOFF = 1e-15
 # a Newton step reuses the previous factor if the last step cut the residual by this much
 CHORD_RATIO = 1e-2
+# columns of the per-fiber data stored by ``assemble``
+FORCE, AXIAL, LENGTH = 0, 1, 2
 
 
 @njit(cache=True)
-def assemble(x, fibers, rest_length, dof, params, residual, matrix, blocks, with_matrix, convexified=False):
-    """Residual (and stiffness) of the interior DOFs; returns (‖f‖₂, ‖f'/L0‖₂, min length).
+def workspace(n_max, m_max, nodes_max):
+    """Work arrays of one thread: residuals, K and its factor (flat, reshaped per RVE), step,
+    trial positions, per-fiber data (f, f'/L0, ℓ) and the node accumulators of the tangent."""
+    return (
+        np.empty(n_max),
+        np.empty(n_max),
+        np.empty(n_max * n_max),
+        np.empty(n_max * n_max),
+        np.empty(n_max),
+        np.empty((nodes_max, 3)),
+        np.empty((m_max, 3)),
+        np.empty((n_max // 3, 6, 3)),
+    )
+
+
+@njit(cache=True)
+def assemble(x, fibers, rest_length, dof, first, params, residual, matrix, fiber_data, with_matrix, convexified):
+    """Residual (and lower envelope of K) of the interior DOFs; returns (‖f‖₂, ‖f'/L0‖₂, min length).
 
     ``convexified`` drops the negative (compressive) geometric stiffness, giving a positive
     semi-definite matrix for the Newton step when the true K is indefinite.
     """
     residual[:] = 0.0
     if with_matrix:
-        matrix[:, :] = 0.0
+        for i in range(residual.shape[0]):
+            for j in range(first[i], i + 1):
+                matrix[i, j] = 0.0
     force_norm2 = 0.0
     stiffness_norm2 = 0.0
     min_length = np.inf
@@ -51,12 +74,16 @@ def assemble(x, fibers, rest_length, dof, params, residual, matrix, blocks, with
         d0, d1, d2 = x[b, 0] - x[a, 0], x[b, 1] - x[a, 1], x[b, 2] - x[a, 2]
         length = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         min_length = min(min_length, length)
+        fiber_data[k, LENGTH] = length
         if length == 0.0:
             continue
         e = (d0 / length, d1 / length, d2 / length)
         f, stiffness = normalized_force_stiffness(length / rest_length[k], params)
+        axial = stiffness / rest_length[k]
+        fiber_data[k, FORCE] = f
+        fiber_data[k, AXIAL] = axial
         force_norm2 += f * f
-        stiffness_norm2 += (stiffness / rest_length[k]) ** 2
+        stiffness_norm2 += axial * axial
         ia, ib = dof[a], dof[b]
         for i in range(3):
             if ia >= 0:
@@ -65,20 +92,20 @@ def assemble(x, fibers, rest_length, dof, params, residual, matrix, blocks, with
                 residual[3 * ib + i] += f * e[i]
         if not with_matrix:
             continue
-        axial, lateral = stiffness / rest_length[k], f / length
+        lateral = f / length
         if convexified:
             lateral = max(lateral, 0.0)
+        low, high = min(ia, ib), max(ia, ib)  # off-diagonal block goes to row block `high`
         for i in range(3):
             for j in range(3):
                 kij = (axial - lateral) * e[i] * e[j] + (lateral if i == j else 0.0)
-                blocks[k, i, j] = kij
-                if ia >= 0:
-                    matrix[3 * ia + i, 3 * ia + j] += kij
-                if ib >= 0:
-                    matrix[3 * ib + i, 3 * ib + j] += kij
-                if ia >= 0 and ib >= 0:
-                    matrix[3 * ia + i, 3 * ib + j] -= kij
-                    matrix[3 * ib + i, 3 * ia + j] -= kij
+                if j <= i:
+                    if ia >= 0:
+                        matrix[3 * ia + i, 3 * ia + j] += kij
+                    if ib >= 0:
+                        matrix[3 * ib + i, 3 * ib + j] += kij
+                if low >= 0:
+                    matrix[3 * high + i, 3 * low + j] -= kij
     return math.sqrt(force_norm2), math.sqrt(stiffness_norm2), min_length
 
 
@@ -100,37 +127,37 @@ def _trial_positions(x, dof, step, alpha, x_trial):
         i = dof[node]
         if i >= 0:
             for c in range(3):
-                x_trial[node, c] = x[node, c] + alpha * step[3 * i + c, 0]
+                x_trial[node, c] = x[node, c] + alpha * step[3 * i + c]
+        else:
+            for c in range(3):
+                x_trial[node, c] = x[node, c]
 
 
 @njit(cache=True)
-def solve_network(X, fibers, rest_length, dof, n_free, x, F, params, tol, max_iter, sensitivity, blocks):
+def solve_network(X, fibers, rest_length, dof, first, n_free, x, params, tol, max_iter, sensitivity, ws):
     """Newton iterations on ``x`` (interior rows updated in place; boundary rows must be F X).
 
-    Fills ``sensitivity`` (3 n_free, 9) with dx/dF and ``blocks`` with the fiber stiffnesses
-    at the converged state.  Returns (status, iterations, relative residual).
+    Fills ``sensitivity`` (3 n_free, 9) with dx/dF at the converged state and leaves the
+    converged per-fiber data in ``ws``.  Returns (status, iterations, relative residual).
     """
     n = 3 * n_free
-    residual = np.empty(n)
-    trial_residual = np.empty(n)
-    matrix = np.empty((n, n))
-    work = np.empty((n, n))
-    step = np.empty((n, 1))
-    x_trial = x.copy()
+    residual, trial_residual = ws[0][:n], ws[1][:n]
+    matrix, work = ws[2][: n * n].reshape((n, n)), ws[3][: n * n].reshape((n, n))
+    step, x_trial, fiber_data = ws[4][:n], ws[5][: x.shape[0]], ws[6]
     status = NOT_CONVERGED
     relative = np.inf
     iterations = 0
     previous_norm = 0.0  # forces a factorisation on the first step
     for iterations in range(max_iter + 1):
         force_norm, stiffness_norm, min_length = assemble(
-            x, fibers, rest_length, dof, params, residual, matrix, blocks, True
+            x, fibers, rest_length, dof, first, params, residual, matrix, fiber_data, True, False
         )
         if min_length < 1e-12:
             return COLLAPSED, iterations, relative
         res_norm = math.sqrt(np.sum(residual * residual))
         relative = res_norm / force_norm if force_norm > 0.0 else 0.0
         if res_norm <= max(tol * force_norm, ROUNDOFF * stiffness_norm):
-            positive_definite = factor_with_shift(matrix, work, n)  # for the tangent
+            positive_definite = factor_with_shift(matrix, work, n, first)  # for the tangent
             status = CONVERGED if positive_definite else INDEFINITE
             break
         if iterations == max_iter:
@@ -138,22 +165,23 @@ def solve_network(X, fibers, rest_length, dof, n_free, x, F, params, tol, max_it
         # chord step (reuse the factor) while the residual falls fast, else refactor; an
         # indefinite K (compressed fibers) is replaced by its convexified version
         if not res_norm < CHORD_RATIO * previous_norm:
-            if not factor_with_shift(matrix, work, n):
-                assemble(x, fibers, rest_length, dof, params, residual, matrix, blocks, True, True)
-                factor_with_shift(matrix, work, n)
+            if not factor_with_shift(matrix, work, n, first):
+                assemble(x, fibers, rest_length, dof, first, params, residual, matrix, fiber_data, True, True)
+                factor_with_shift(matrix, work, n, first)
         previous_norm = res_norm
-        step[:, 0] = -residual
-        cholesky_solve(work, n, step)
+        for i in range(n):
+            step[i] = -residual[i]
+        cholesky_solve_vector(work, n, first, step)
         # full step if it lowers the residual (or we are already close); otherwise Armijo
         # backtracking on the energy Π, for which the step is a descent direction
         _trial_positions(x, dof, step, 1.0, x_trial)
-        assemble(x_trial, fibers, rest_length, dof, params, trial_residual, matrix, blocks, False)
+        assemble(x_trial, fibers, rest_length, dof, first, params, trial_residual, matrix, fiber_data, False, False)
         trial_res = math.sqrt(np.sum(trial_residual * trial_residual))
         if not (trial_res < res_norm or relative < 1e-6):
             energy = network_energy(x, fibers, rest_length, params)
             slope = 0.0
             for i in range(n):
-                slope += residual[i] * step[i, 0]
+                slope += residual[i] * step[i]
             alpha = 1.0
             for _ in range(60):
                 if network_energy(x_trial, fibers, rest_length, params) <= energy + 1e-4 * alpha * slope:
@@ -163,32 +191,35 @@ def solve_network(X, fibers, rest_length, dof, n_free, x, F, params, tol, max_it
         x[:, :] = x_trial
     if status == NOT_CONVERGED:
         return status, iterations, relative
-    _sensitivities(X, fibers, dof, n_free, work, blocks, sensitivity)
+    _sensitivities(X, x, fibers, dof, first, n_free, work, fiber_data, sensitivity)
     return status, iterations, relative
 
 
 @njit(cache=True)
-def _sensitivities(X, fibers, dof, n_free, factor, blocks, sensitivity):
-    """dx_int/dF_pq = −K_ii⁻¹ K_ib (e_p X_q) for the 9 components, column pq = 3p + q."""
-    n = 3 * n_free
+def _sensitivities(X, x, fibers, dof, first, n_free, factor, fiber_data, sensitivity):
+    """dx_int/dF_pq = −K_ii⁻¹ K_ib (e_p X_q) for the 9 components, column pq = 3p + q.
+
+    The 9 right-hand sides are the columns of ``sensitivity``, solved in one blocked sweep.
+    """
     sensitivity[:, :] = 0.0
     for k in range(fibers.shape[0]):
         a, b = fibers[k, 0], fibers[k, 1]
         ia, ib = dof[a], dof[b]
         if (ia >= 0) == (ib >= 0):
             continue  # only interior–boundary fibers load the interior
-        for p in range(3):
-            for q in range(3):
-                # boundary velocity δx = e_p X_q; t = K_k (δx_b − δx_a)
-                vb = X[b, q] if ib < 0 else 0.0
-                va = X[a, q] if ia < 0 else 0.0
-                for i in range(3):
-                    t = blocks[k, i, p] * (vb - va)
-                    if ia >= 0:
-                        sensitivity[3 * ia + i, 3 * p + q] += t
-                    if ib >= 0:
-                        sensitivity[3 * ib + i, 3 * p + q] -= t
-    cholesky_solve(factor, n, sensitivity)
+        length = fiber_data[k, LENGTH]
+        lateral = fiber_data[k, FORCE] / length
+        axial = fiber_data[k, AXIAL]
+        e = ((x[b, 0] - x[a, 0]) / length, (x[b, 1] - x[a, 1]) / length, (x[b, 2] - x[a, 2]) / length)
+        # boundary velocity δx = e_p X_q of the boundary end; the interior row gets K_k δx
+        # (with the sign of −K_ib = +K_k whichever end is interior)
+        row, node = (ia, b) if ia >= 0 else (ib, a)
+        for i in range(3):
+            for p in range(3):
+                kip = (axial - lateral) * e[i] * e[p] + (lateral if i == p else 0.0)
+                for q in range(3):
+                    sensitivity[3 * row + i, 3 * p + q] += kip * X[node, q]
+    cholesky_solve(factor, 3 * n_free, first, sensitivity)
 
 
 @njit(cache=True)
@@ -207,51 +238,66 @@ SYM_I = (0, 1, 2, 0, 0, 1)  # the 6 independent (i, j) of a symmetric 3×3 tenso
 SYM_J = (0, 1, 2, 1, 2, 2)
 
 
-@njit(cache=True)
-def _node_velocity(node, dof, X, sensitivity, out):
-    """∂x_node/∂F_pq as a (3, 9) array: dx/dF rows for interior nodes, δ_ip X_q on the boundary."""
-    i = dof[node]
-    if i >= 0:
-        for c in range(3):
-            for pq in range(9):
-                out[c, pq] = sensitivity[3 * i + c, pq]
-    else:
-        out[:, :] = 0.0
-        for p in range(3):
-            for q in range(3):
-                out[p, 3 * p + q] = X[node, q]
+@njit(cache=True, fastmath=FAST)
+def stress_and_tangent(
+    X, x, fibers, rest_length, dof, F, scale, sensitivity, fiber_data, node_sum, cauchy, tangent, stretch
+):
+    """σ = scale/J Σ (f/ℓ) d⊗d (Eq. 8 as a fiber virial) and dσ_ij/dF_pq, fiber stretches.
 
-
-@njit(cache=True)
-def stress_and_tangent(X, x, fibers, rest_length, dof, F, params, scale, sensitivity, cauchy, tangent, stretch):
-    """σ = scale/J Σ (f/ℓ) d⊗d (Eq. 8 as a fiber virial) and dσ_ij/dF_pq, fiber stretches."""
+    The virial's derivative is linear in the end velocities δd = v_b − v_a of each fiber:
+    Σ_k A_k δd_k with A_k[ij, c] = ∂(f/ℓ)/∂ℓ (d_c/ℓ) d_i d_j + (f/ℓ)(δ_ic d_j + d_i δ_jc).
+    A boundary end moves with v_c,pq = δ_cp X_q, so its share is A_k[ij, p] X_q at once; the
+    interior ends are first summed per node (``node_sum``, n_free × 6 × 3) and multiplied by
+    the node sensitivities once per node instead of once per fiber.
+    """
     J, F_inv = _det_inv3(F)
     virial = np.zeros(6)
     dvirial = np.zeros((6, 9))
-    d = np.empty(3)
-    va, vb = np.empty((3, 9)), np.empty((3, 9))
-    dd = np.empty((3, 9))
-    dlength = np.empty(9)
+    node_sum[:, :, :] = 0.0
+    A = np.empty((6, 3))
+    dd = np.empty(6)
     for k in range(fibers.shape[0]):
         a, b = fibers[k, 0], fibers[k, 1]
-        for i in range(3):
-            d[i] = x[b, i] - x[a, i]
-        length = math.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2)
+        d = (x[b, 0] - x[a, 0], x[b, 1] - x[a, 1], x[b, 2] - x[a, 2])
+        length = fiber_data[k, LENGTH]
         stretch[k] = length / rest_length[k]
-        f, stiffness = normalized_force_stiffness(stretch[k], params)
-        ratio = f / length
-        dratio = (stiffness / rest_length[k] - ratio) / length  # ∂(f/ℓ)/∂ℓ
-        _node_velocity(a, dof, X, sensitivity, va)
-        _node_velocity(b, dof, X, sensitivity, vb)
-        for pq in range(9):
-            for i in range(3):
-                dd[i, pq] = vb[i, pq] - va[i, pq]
-            dlength[pq] = dratio * (d[0] * dd[0, pq] + d[1] * dd[1, pq] + d[2] * dd[2, pq]) / length
+        ratio = fiber_data[k, FORCE] / length
+        dratio = (fiber_data[k, AXIAL] - ratio) / length  # ∂(f/ℓ)/∂ℓ
+        scaled = dratio / length
         for s in range(6):
             i, j = SYM_I[s], SYM_J[s]
-            virial[s] += ratio * d[i] * d[j]
-            for pq in range(9):
-                dvirial[s, pq] += dlength[pq] * d[i] * d[j] + ratio * (dd[i, pq] * d[j] + d[i] * dd[j, pq])
+            dd[s] = d[i] * d[j]
+            virial[s] += ratio * dd[s]
+            for c in range(3):
+                A[s, c] = scaled * dd[s] * d[c]
+            A[s, i] += ratio * d[j]
+            A[s, j] += ratio * d[i]
+        ia, ib = dof[a], dof[b]
+        if ib >= 0:
+            for s in range(6):
+                for c in range(3):
+                    node_sum[ib, s, c] += A[s, c]
+        if ia >= 0:
+            for s in range(6):
+                for c in range(3):
+                    node_sum[ia, s, c] -= A[s, c]
+        if ia < 0 or ib < 0:
+            w0, w1, w2 = 0.0, 0.0, 0.0
+            if ib < 0:
+                w0, w1, w2 = X[b, 0], X[b, 1], X[b, 2]
+            if ia < 0:
+                w0, w1, w2 = w0 - X[a, 0], w1 - X[a, 1], w2 - X[a, 2]
+            for s in range(6):
+                for p in range(3):
+                    dvirial[s, 3 * p] += A[s, p] * w0
+                    dvirial[s, 3 * p + 1] += A[s, p] * w1
+                    dvirial[s, 3 * p + 2] += A[s, p] * w2
+    for node in range(node_sum.shape[0]):
+        for s in range(6):
+            for c in range(3):
+                g = node_sum[node, s, c]
+                for pq in range(9):
+                    dvirial[s, pq] += g * sensitivity[3 * node + c, pq]
     factor = scale / J
     for s in range(6):
         i, j = SYM_I[s], SYM_J[s]
@@ -287,6 +333,7 @@ def solve_one(
     fibers,
     rest_length,
     dof,
+    first,
     n_free,
     x_previous,
     F_previous,
@@ -300,15 +347,17 @@ def solve_one(
     cauchy,
     tangent,
     stretch,
+    ws,
 ):
     """Predict, solve, post-process one RVE; ``sensitivity`` is read then overwritten."""
     predict(X, dof, x_previous, F_previous, sensitivity, F, x)
-    blocks = np.empty((fibers.shape[0], 3, 3))
     status, iterations, relative = solve_network(
-        X, fibers, rest_length, dof, n_free, x, F, params, tol, max_iter, sensitivity, blocks
+        X, fibers, rest_length, dof, first, n_free, x, params, tol, max_iter, sensitivity, ws
     )
     if status == CONVERGED or status == INDEFINITE:
-        stress_and_tangent(X, x, fibers, rest_length, dof, F, params, scale, sensitivity, cauchy, tangent, stretch)
+        stress_and_tangent(
+            X, x, fibers, rest_length, dof, F, scale, sensitivity, ws[6], ws[7][:n_free], cauchy, tangent, stretch
+        )
     return status, iterations, relative
 
 
@@ -321,6 +370,7 @@ def solve_many(
     fibers,
     rest_length,
     dof,
+    first,
     n_free,
     x_previous,
     F_previous,
@@ -337,28 +387,41 @@ def solve_many(
     status,
     iterations,
     relative,
+    n_chunks,
 ):
-    """``solve_one`` over a batch of RVEs packed end to end (offset arrays of length B + 1)."""
-    for r in prange(F.shape[0]):
-        n0, n1 = node_start[r], node_start[r + 1]
-        m0, m1 = fiber_start[r], fiber_start[r + 1]
-        s0, s1 = free_start[r], free_start[r + 1]
-        status[r], iterations[r], relative[r] = solve_one(
-            X[n0:n1],
-            fibers[m0:m1],
-            rest_length[m0:m1],
-            dof[n0:n1],
-            n_free[r],
-            x_previous[n0:n1],
-            F_previous[r],
-            sensitivity[s0:s1],
-            F[r],
-            params,
-            scale[r],
-            tol,
-            max_iter,
-            x[n0:n1],
-            cauchy[r],
-            tangent[r],
-            stretch[m0:m1],
-        )
+    """``solve_one`` over a batch of RVEs packed end to end (offset arrays of length B + 1).
+
+    The batch is cut into ``n_chunks`` contiguous chunks scheduled by ``prange``; each chunk
+    allocates one workspace and reuses it for its RVEs.
+    """
+    batch = F.shape[0]
+    n_max = 3 * np.max(n_free)
+    m_max = np.max(fiber_start[1:] - fiber_start[:-1])
+    nodes_max = np.max(node_start[1:] - node_start[:-1])
+    for chunk in prange(n_chunks):
+        ws = workspace(n_max, m_max, nodes_max)
+        for r in range(chunk * batch // n_chunks, (chunk + 1) * batch // n_chunks):
+            n0, n1 = node_start[r], node_start[r + 1]
+            m0, m1 = fiber_start[r], fiber_start[r + 1]
+            s0, s1 = free_start[r], free_start[r + 1]
+            status[r], iterations[r], relative[r] = solve_one(
+                X[n0:n1],
+                fibers[m0:m1],
+                rest_length[m0:m1],
+                dof[n0:n1],
+                first[s0:s1],
+                n_free[r],
+                x_previous[n0:n1],
+                F_previous[r],
+                sensitivity[s0:s1],
+                F[r],
+                params,
+                scale[r],
+                tol,
+                max_iter,
+                x[n0:n1],
+                cauchy[r],
+                tangent[r],
+                stretch[m0:m1],
+                ws,
+            )

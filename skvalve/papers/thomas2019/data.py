@@ -10,6 +10,7 @@ This module holds data only; the models built from it are in :mod:`.models`.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 # --- fitted model parameters (§3, "The model fit parameters ..."; ν and ψ, d: §2.4–2.5)
 G = 2.1e3  # matrix shear modulus (Pa), §3
@@ -73,3 +74,41 @@ SENSITIVITY_SSE_PERCENT = {"lambda_c": (160.28, 325.42), "G": (35.66, 39.74), "E
 # --- cost of the paper's simulation (§2.5)
 PAPER_CORES = 200
 PAPER_WALL_HOURS = 15.0
+
+
+# --- the same parameters grouped for the library calls (frozen; every value is one of the constants above,
+#     with its place in the paper given there and repeated here)
+@dataclass(frozen=True)
+class MatrixParameters:
+    """Eq. 10, compressible neo-Hookean matrix: shear modulus G (Pa, fitted, §3) and ν (§2.4 assumption 2)."""
+
+    G: float
+    nu: float
+
+
+@dataclass(frozen=True)
+class FiberParameters:
+    """Eq. 9 fiber law: E_f (Pa), β, λc (fitted, §3) and the fiber diameter d (m, §2.5, "assumed to be 450 nm")."""
+
+    E_f: float
+    beta: float
+    lambda_c: float
+    diameter: float
+
+    @property
+    def area(self) -> float:
+        """A_f = π d²/4 of Eqs. 6–9 (circular fiber)."""
+        return math.pi * self.diameter**2 / 4.0
+
+
+@dataclass(frozen=True)
+class NetworkParameters:
+    """RVE networks (§2.5): fiber volume fraction ψ (Eqs. 6–8, "43%") and fibers per RVE ("an average of 450")."""
+
+    volume_fraction: float
+    fibers_per_rve: int
+
+
+MATRIX = MatrixParameters(G=G, nu=NU)  # §3, §2.4
+FIBER = FiberParameters(E_f=E_F, beta=BETA, lambda_c=LAMBDA_C, diameter=FIBER_DIAMETER)  # §3, §2.5
+NETWORK = NetworkParameters(volume_fraction=PSI, fibers_per_rve=FIBERS_PER_RVE)  # §2.5
