@@ -77,14 +77,16 @@ def test_symmetric_saddle_point_without_stored_diagonal(name):
 
 def test_module_solve_keeps_the_analysis_between_calls():
     A = _laplacian_like(400, 6, symmetric=True)
-    linsolve._SOLVERS.clear()
+    linsolve.clear_cache()
     name = linsolve.solver_name()
     for seed in range(3):
         K = _same_pattern_new_values(A, 20 + seed, symmetric=True)
         x = linsolve.solve(K, np.ones(400), name, symmetric=True)
         assert np.allclose(K @ x, np.ones(400), rtol=1e-10)
-    stats = linsolve._SOLVERS[(name, True)].statistics
+    stats = linsolve._CACHE.solvers[(name, True)].statistics
     assert (stats.analyses, stats.factorizations) == (1, 3)
+    linsolve.clear_cache()
+    assert not linsolve._CACHE.solvers
 
 
 def test_factorize_rejects_another_pattern_and_order_of_calls():
@@ -163,3 +165,17 @@ def test_empty_system_every_dof_prescribed(name):
     x = LinearSolver(name, symmetric=True).analyse(empty).factorize(empty).solve(np.zeros(0))
     assert x.shape == (0,)
     assert linsolve.solve(empty, np.zeros(0), name, symmetric=True).shape == (0,)
+
+
+def test_module_solve_keeps_one_solver_per_thread():
+    from concurrent.futures import ThreadPoolExecutor
+
+    matrices = [_laplacian_like(400, 30 + k, symmetric=True) for k in range(4)]
+
+    def work(K):
+        x = linsolve.solve(K, np.ones(400), None, symmetric=True)
+        return np.linalg.norm(K @ x - np.ones(400))
+
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        residuals = list(pool.map(work, matrices * 2))
+    assert max(residuals) < 1e-10

@@ -32,6 +32,7 @@ from __future__ import annotations
 import ctypes
 import importlib.util
 import sys
+import threading
 import warnings
 from dataclasses import dataclass
 
@@ -41,7 +42,7 @@ import scipy.sparse.linalg as spla
 
 __all__ = [
     "LinearSolver", "SolverStatistics", "SolverUnavailableError", "SlowSolverWarning", "solve", "solver_name",
-    "available_solvers",
+    "available_solvers", "clear_cache",
 ]
 
 _BACKENDS = (("pardiso", "pypardiso"), ("umfpack", "scikits.umfpack"))
@@ -360,24 +361,38 @@ class LinearSolver:
         self._permutation = None
 
 
-_SOLVERS: dict[tuple[str, bool], LinearSolver] = {}
+class _PerThread(threading.local):
+    solvers: dict[tuple[str, bool], LinearSolver]
+
+    def __init__(self) -> None:
+        self.solvers = {}
+
+
+_CACHE = _PerThread()
+
+
+def clear_cache() -> None:
+    """Release the factorisations kept by :func:`solve` in this thread (their memory goes back to MKL)."""
+    for linear in _CACHE.solvers.values():
+        linear._release()
+    _CACHE.solvers.clear()
 
 
 def solve(matrix: sp.spmatrix, rhs: np.ndarray, solver: str | None = None, symmetric: bool = False) -> np.ndarray:
     """Solve ``matrix @ x = rhs`` (square) and return ``x``.
 
-    Keeps one :class:`LinearSolver` per (backend, symmetric) in this process: consecutive calls
+    Keeps one :class:`LinearSolver` per (backend, symmetric) and thread: consecutive calls
     with the same sparsity pattern reuse its analysis, with the same values its factorisation.
     ``symmetric=True`` promises ``matrix == matrix.T``. Raises ``np.linalg.LinAlgError`` when the
-    system is singular or the result is not finite.
+    system is singular or the result is not finite. :func:`clear_cache` frees the kept factors.
     """
     name = solver_name(solver)
     csr = sp.csr_matrix(matrix)
     csr.sort_indices()
     key = (name, bool(symmetric))
-    if key not in _SOLVERS:
-        _SOLVERS[key] = LinearSolver(name, symmetric)
-    linear = _SOLVERS[key]
+    if key not in _CACHE.solvers:
+        _CACHE.solvers[key] = LinearSolver(name, symmetric)
+    linear = _CACHE.solvers[key]
     linear.analyse((csr.indptr, csr.indices))
     linear.factorize(csr.data)
     return linear.solve(rhs)
