@@ -45,7 +45,7 @@ class GaussPointWriter:
     Parameters
     ----------
     path : the ``.pvd`` collection; step files are ``<stem>_<step>.vtu`` beside it.
-    solid, material : the problem and its RVE material.
+    solid, material : the problem (None: the problem of the solver's event) and its RVE material.
     cell_data : extra constant cell fields (e.g. α of each element's network).
     """
 
@@ -59,6 +59,8 @@ class GaussPointWriter:
         self.entries: list[tuple[float, str]] = []
 
     def __call__(self, event) -> None:
+        if self.solid is None:
+            self.solid = event.problem
         self.write(event.load_factor, event.u)
 
     def write(self, t: float, u: np.ndarray) -> Path:

@@ -106,6 +106,7 @@ class ProtocolRun:
     u: np.ndarray
     corrections: int
     iterations: int
+    timings: dict  # solver wall time: assembly (RVE solves included), sparse solves, set-up
     solid: Solid = field(repr=False)
     material: RVEMaterial = field(repr=False)
 
@@ -151,6 +152,7 @@ def run_protocol(sample: Sample, material: RVEMaterial, ratio: tuple[float, floa
     schedule.add(1.0, delta)
     result = solve(solid, steps=steps, progress=progress, rtol=rtol, callbacks=[record, *callbacks])
     iterations = result.iterations
+    timings = dict(result.timings)
     u, t = result.u(), 1.0
     corrections = 0
     while np.abs(tensions[-1] - goal).max() > tolerance * max_tension:
@@ -164,9 +166,10 @@ def run_protocol(sample: Sample, material: RVEMaterial, ratio: tuple[float, floa
         result = solve(solid, steps=[t + 1.0], u0=u, t0=t, progress=progress, rtol=rtol,
                        callbacks=[record, *callbacks])
         iterations += result.iterations
+        timings = {key: timings.get(key, 0.0) + value for key, value in result.timings.items()}
         u, t = result.u(), t + 1.0
         corrections += 1
         change = tensions[-1] - before  # Broyden's rank-one update of dT/dδ
         jacobian = jacobian + np.outer(change - jacobian @ step, step) / (step @ step)
     return ProtocolRun(tuple(ratio), goal, delta, np.array(stretches), np.array(tensions), u, corrections,
-                       iterations, solid, material)
+                       iterations, timings, solid, material)

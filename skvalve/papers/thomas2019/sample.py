@@ -14,9 +14,10 @@ right, bottom) rising to 28 % at the top edge,
 .. math::
 
     \alpha = \alpha_e + (\alpha_c - \alpha_e)\, s\!\left(\frac{d - d_0}{d_1 - d_0}\right),\qquad
-    \alpha_e = 27 + \max(0, 2\eta - 1),
+    \alpha_e = 27 + (28 - 27)\, s\!\left(\frac{\eta - 0.5}{\eta_3 - 0.5}\right),
 
-with the smoothstep :math:`s(\xi) = 3\xi^2 - 2\xi^3` clipped to [0, 1], η = y/7 mm,
+with the smoothstep :math:`s(\xi) = 3\xi^2 - 2\xi^3` clipped to [0, 1], η = y/7 mm, η₃ = 0.91 the
+height of N3 (so α_e = 27 % below mid-height, 28 % from N3's height up),
 :math:`d_0` = 1 mm, :math:`d_1` = 3 mm (N2 and N3 lie in the edge band, N1 in the plateau);
 μ = 0° (circumferential) everywhere. A user map replaces it: an array of (α, μ) per element, or a
 callable ``(x, y) -> (alpha, mu)`` of element-centre coordinates in metres.
@@ -90,7 +91,8 @@ def default_alpha_mu(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarr
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     distance = np.minimum.reduce([x, width - x, y, height - y]) * 1e3  # mm to the nearest edge
     eta = y / height
-    edge = data.ALPHA_N2 + (data.ALPHA_N3 - data.ALPHA_N2) * np.maximum(0.0, 2.0 * eta - 1.0)
+    eta_n3 = data.NETWORK_LOCATIONS["N3"][1]
+    edge = data.ALPHA_N2 + (data.ALPHA_N3 - data.ALPHA_N2) * _smoothstep((eta - 0.5) / (eta_n3 - 0.5))
     d0, d1 = data.DEFAULT_MAP_EDGE_BAND_MM
     alpha = edge + (data.ALPHA_N1 - edge) * _smoothstep((distance - d0) / (d1 - d0))
     return alpha, np.zeros_like(alpha)
