@@ -42,7 +42,7 @@ def test_valve_info_writes_summary_and_picture(deck, tmp_path):
     text_file, picture = summary.outputs
     assert text_file.read_text() == summary.to_text()
     pixels = image.imread(picture)
-    assert pixels.shape[:2] == (1050, 1200)
+    assert pixels.shape[:2] == (780, 1560)
     assert len(np.unique(pixels.reshape(-1, pixels.shape[2]), axis=0)) > 10  # something was drawn
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["summary.txt", "undeformed.png"]
 

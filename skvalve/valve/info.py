@@ -208,30 +208,36 @@ def plot_undeformed(model: AbaqusModel, out_dir: str | os.PathLike, name: str = 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     x = model.nodes
-    figure = Figure(figsize=(8, 7), dpi=150)
+    figure = Figure(figsize=(13, 6.5), dpi=120)
     FigureCanvasAgg(figure)
-    axes = figure.add_subplot(projection="3d")
-    handles = []
-    for label, kind, data in plot_layers(model):
-        leaflet = label.split()[0]
-        if kind == "faces":
-            colour = LEAFLET_COLOURS.get(leaflet, "#bbbbbb")
-            collection = Poly3DCollection(x[data], facecolors=colour, edgecolors="none", alpha=0.85, label=label)
-            axes.add_collection3d(collection)
-        elif kind == "lines":
-            collection = Line3DCollection(x[data], colors=CHORDAE_COLOUR, linewidths=0.6, label=label)
-            axes.add_collection3d(collection)
-        else:
-            collection = axes.scatter(*x[data].T, s=1, color="k", label=label)
-        handles.append(collection)
+    layers = plot_layers(model)
     low, high = x.min(axis=0), x.max(axis=0)
     centre, half = 0.5 * (low + high), 0.5 * float(np.max(high - low)) or 1.0
-    axes.set(xlim=(centre[0] - half, centre[0] + half), ylim=(centre[1] - half, centre[1] + half),
-             zlim=(centre[2] - half, centre[2] + half), xlabel="x (mm)", ylabel="y (mm)", zlabel="z (mm)")
-    axes.set_box_aspect((1, 1, 1))
-    axes.view_init(elev=35, azim=-60)
-    axes.legend(handles=handles, loc="upper left", fontsize=9)
-    axes.set_title(f"{model.path.name}: undeformed", fontsize=11)
+    for panel, (elevation, azimuth, title) in enumerate([(35, -60, "oblique"), (90, -90, "viewed along -z")], start=1):
+        axes = figure.add_subplot(1, 2, panel, projection="3d")
+        handles = []
+        for label, kind, data in layers:
+            if kind == "faces":
+                colour = LEAFLET_COLOURS.get(label.split()[0], "#bbbbbb")
+                collection = Poly3DCollection(x[data], facecolors=colour, edgecolors="none", alpha=0.85, label=label)
+                axes.add_collection3d(collection)
+            elif kind == "lines":
+                collection = Line3DCollection(x[data], colors=CHORDAE_COLOUR, linewidths=0.6, label=label)
+                axes.add_collection3d(collection)
+            else:
+                collection = axes.scatter(*x[data].T, s=1, color="k", label=label)
+            handles.append(collection)
+        axes.set(xlim=(centre[0] - half, centre[0] + half), ylim=(centre[1] - half, centre[1] + half),
+                 zlim=(centre[2] - half, centre[2] + half), xlabel="x (mm)", ylabel="y (mm)", zlabel="z (mm)")
+        axes.set_box_aspect((1, 1, 1))
+        axes.view_init(elev=elevation, azim=azimuth)
+        axes.set_title(title, fontsize=10)
+        if panel == 1:
+            axes.legend(handles=handles, loc="upper left", fontsize=9)
+        else:
+            axes.set_zticks([])
+            axes.set_zlabel("")
+    figure.suptitle(f"{model.path.name}: undeformed", fontsize=12)
     target = out / name
     partial = out / f".{name}.partial"
     figure.savefig(partial, format="png")
