@@ -184,3 +184,55 @@ def test_trivalve_diseased_orifice_and_leaflets():
     for name, faces in areas.centre_faces.items():
         assert areas.centre_area[name] == pytest.approx(0.1 * areas.leaflet[name]["mid"], rel=0.05)
         assert len(faces) > 10
+
+
+def _band_deck(radius, thickness, height, n, rows, layers):
+    """A cylindrical band of bricks (``layers`` through the thickness, outermost = pressure-loaded S1),
+    split into three leaflets of n/3 sectors each; annulus node set at z = 0."""
+    def node(i, j, k):
+        return 1 + i * n * (rows + 1) + k * n + (j % n)
+
+    lines = ["*Node"]
+    for i in range(layers + 1):
+        r = radius + thickness / 2 - i * thickness / layers
+        for k in range(rows + 1):
+            for j in range(n):
+                x, y = (float(v) for v in r * np.array([np.cos(2 * np.pi * j / n), np.sin(2 * np.pi * j / n)]))
+                lines.append(f"{node(i, j, k)}, {x!r}, {y!r}, {height * k / rows!r}")
+    lines.append("*Element, type=C3D8R")
+    sectors = {name: [] for name in ("Anterior", "Posterior", "Septal")}
+    outer = []
+    label = 0
+    for i in range(layers):
+        for k in range(rows):
+            for j in range(n):
+                label += 1
+                bottom = [node(i, j, k), node(i, j, k + 1), node(i, j + 1, k + 1), node(i, j + 1, k)]
+                top = [node(i + 1, j, k), node(i + 1, j, k + 1), node(i + 1, j + 1, k + 1), node(i + 1, j + 1, k)]
+                lines.append(", ".join(str(v) for v in [label, *bottom, *top]))
+                sectors[list(sectors)[3 * j // n]].append(label)
+                if i == 0:
+                    outer.append(label)
+    for name, labels in sectors.items():
+        lines += [f"*Elset, elset={name}_Leaflet_Elements", *(f"{v}," for v in labels)]
+    lines += ["*Elset, elset=Outer", *(f"{v}," for v in outer), "*Surface, name=Ventricular", "Outer, S1",
+              "*Nset, nset=Annular_Nodes", *(f"{node(i, j, 0)}," for i in range(layers + 1) for j in range(n)),
+              "*Step", "*Static", "*Dsload", "Ventricular, P, 0.005", "*End Step"]
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize("layers", [3, 4])
+def test_leaflet_surfaces_of_a_brick_band(tmp_path, layers):
+    radius, thickness, height, n, rows = 10.0, 0.8, 6.0, 24, 4
+    path = tmp_path / "band.inp"
+    path.write_text(_band_deck(radius, thickness, height, n, rows, layers))
+    logging.getLogger("skvalve.io.abaqus.reader").setLevel(logging.ERROR)
+    model = read_model(path)
+    surfaces = leaflet_surfaces(model)
+    for scale in (1.0, 1.1):  # the reference and a uniformly dilated configuration
+        areas = valve_areas(surfaces, scale * model.nodes, annulus_nodes(model))
+        for which, r in (("ventricular", radius + thickness / 2), ("mid", radius), ("atrial", radius - thickness / 2)):
+            band = scale**2 * height * n * 2 * r * np.sin(np.pi / n)  # faceted cylinder of radius r
+            assert areas.total(which) == pytest.approx(band, rel=1e-12)
+            assert areas.leaflet["Septal"][which] == pytest.approx(band / 3, rel=1e-12)
+            assert areas.orifice[which] == pytest.approx(scale**2 * 0.5 * n * r**2 * np.sin(2 * np.pi / n), rel=1e-12)
