@@ -105,3 +105,33 @@ def test_overflow_raises_naming_the_stretch():
         with pytest.raises(ValueError, match="overflows at stretch 1.09"):
             method([1.0, 1.09])
         assert np.isfinite(method(1.0))
+
+
+@pytest.mark.parametrize("beta", [1e-17, 1e-12, 1e-9])
+def test_small_beta_gives_the_linear_limit(beta):
+    """(exp(β e) − 1)/β lost every digit for tiny β (β = 1e-17 gave force 0, not e_G = 0.105 at λ = 1.1)."""
+    fiber = ExponentialFiber(1.0, 1.0, beta, 1.5)
+    lam = np.array([0.9, 1.1, 1.3, 1.7])
+    strain = 0.5 * (np.minimum(lam, 1.5) ** 2 - 1)  # e_G, capped at λc for the linear branch
+    # f = e_G (1 + β e_G/2 + …) below λc; above, f(λc) + λc (1 + β e_c) (λ − λc)
+    expected = np.where(lam < 1.5, strain, strain + 1.5 * (lam - 1.5))
+    np.testing.assert_allclose(fiber.force(lam), expected, rtol=10 * beta + 1e-15)
+    assert fiber.force(1.1) == pytest.approx(0.105, rel=10 * beta + 1e-14)
+    # the energy ∫ f dλ: for λ < λc, ∫₁^λ (s² − 1)/2 ds = (λ³ − 1)/6 − (λ − 1)/2
+    assert fiber.energy(1.1) == pytest.approx((1.1**3 - 1) / 6 - 0.05, rel=10 * beta + 1e-13)
+
+
+@pytest.mark.parametrize("bad", ["10.5e3", None, np.array([1.0, 2.0]), True, [1.0]])
+def test_parameters_must_be_real_numbers(bad):
+    for name, args in (
+        ("E_f", (bad, 1.0, 50.5, 1.12)),
+        ("A_f", (1.0, bad, 50.5, 1.12)),
+        ("beta", (1.0, 1.0, bad, 1.12)),
+        ("lambda_c", (1.0, 1.0, 50.5, bad)),
+    ):
+        with pytest.raises(TypeError, match=f"ExponentialFiber: parameter {name} must be a real number"):
+            ExponentialFiber(*args)
+    with pytest.raises(TypeError, match="slack_stiffness"):
+        ExponentialFiber(1.0, 1.0, 50.5, 1.12, slack_stiffness=bad)
+    with pytest.raises(TypeError, match="diameter"):
+        ExponentialFiber.from_diameter(1.0, bad, 50.5, 1.12)

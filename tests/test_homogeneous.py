@@ -24,18 +24,20 @@ def _ogden_uniaxial(mu, alpha, lam):
     [IncompressibleNeoHookean(45.0), NeoHookean(45.0, 300.0), Ogden((45.0,), (2.0,)), Ogden((45.0,), (2.0,), (0.01,))],
 )
 def test_neo_hookean_incompressible_closed_forms(law):
-    """sigma = mu(l^2 - 1/l) uniaxial, mu(l^2 - l^-4) equibiaxial, mu(l1^2 - (l1 l2)^-2) biaxial."""
+    """sigma = mu(l^2 - 1/l) uniaxial, mu(l^2 - l^-4) equibiaxial, mu(l1^2 - (l1 l2)^-2) biaxial.
+
+    The compressible laws are asked for their incompressible limit explicitly."""
     mu = 45.0
-    uni = uniaxial(law, STRETCHES)
+    uni = uniaxial(law, STRETCHES, incompressible=True)
     np.testing.assert_allclose(uni.cauchy[0], mu * (STRETCHES**2 - 1 / STRETCHES), rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(uni.nominal[0], mu * (STRETCHES - STRETCHES**-2), rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(uni.stretches[1], STRETCHES**-0.5, rtol=1e-15)
     np.testing.assert_array_equal(uni.cauchy[1:], 0.0)
     np.testing.assert_allclose(uni.J, 1.0, rtol=1e-15)
-    equi = equibiaxial(law, STRETCHES)
+    equi = equibiaxial(law, STRETCHES, incompressible=True)
     np.testing.assert_allclose(equi.cauchy[0], mu * (STRETCHES**2 - STRETCHES**-4), rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(equi.cauchy[1], equi.cauchy[0], rtol=1e-14, atol=1e-12)
-    bi = biaxial(law, 1.3, STRETCHES)
+    bi = biaxial(law, 1.3, STRETCHES, incompressible=True)
     np.testing.assert_allclose(bi.cauchy[0], mu * (1.3**2 - (1.3 * STRETCHES) ** -2), rtol=1e-12)
     np.testing.assert_allclose(bi.cauchy[1], mu * (STRETCHES**2 - (1.3 * STRETCHES) ** -2), rtol=1e-12, atol=1e-12)
     assert bi.cauchy.shape == (3, STRETCHES.size) and np.all(bi.cauchy[2] == 0.0)
@@ -53,7 +55,8 @@ def test_lee_sacks_incompressible_closed_form():
     c0, c1, c2 = 1e-3, 1.188659e-4, 15.260081  # Texas TriValve anterior leaflet (MPa)
     x = STRETCHES**2 + 2 / STRETCHES - 3
     expected = 2 * (c0 / 2 + c1 * c2 * x * np.exp(c2 * x**2)) * (STRETCHES**2 - 1 / STRETCHES)
-    np.testing.assert_allclose(uniaxial(LeeSacks(c0, c1, c2, 20.0669), STRETCHES).cauchy[0], expected, rtol=1e-11)
+    compressible = LeeSacks(c0, c1, c2, 20.0669)
+    np.testing.assert_allclose(uniaxial(compressible, STRETCHES, incompressible=True).cauchy[0], expected, rtol=1e-11)
     published = 2 * (c0 / 2 + c1 * c2 / 2 * np.exp(c2 * x)) * (STRETCHES**2 - 1 / STRETCHES)
     law = LeeSacks(c0, c1, c2, published_equation=True)
     np.testing.assert_allclose(uniaxial(law, STRETCHES).cauchy[0], published, rtol=1e-11)
@@ -218,3 +221,19 @@ def test_compressible_neo_hookean_biaxial_against_independent_root():
         assert out.stretches[2, i] == pytest.approx(l3, rel=1e-12)
         expected = np.array([mu / J * (1.2**2 - 1), mu / J * (lam2**2 - 1)]) + lm * np.log(J) / J
         np.testing.assert_allclose(out.cauchy[:2, i], expected, rtol=1e-10, atol=1e-13)
+
+
+def test_compressible_law_must_choose_the_solve():
+    """A compressible law used to be solved as incompressible when ``incompressible`` was left out."""
+    law = NeoHookean.from_shear_poisson(1.0, 0.3)
+    for solve in (lambda: uniaxial(law, 1.2), lambda: equibiaxial(law, 1.2), lambda: biaxial(law, 1.2, 1.1)):
+        with pytest.raises(ValueError, match="NeoHookean is compressible: choose incompressible=False"):
+            solve()
+    with pytest.raises(TypeError, match="incompressible must be True, False or None"):
+        uniaxial(law, 1.2, incompressible="no")
+    # each explicit choice gives its own, different answer: free lateral stretch (J ≠ 1) vs J = 1
+    own, limit = uniaxial(law, 1.2, incompressible=False), uniaxial(law, 1.2, incompressible=True)
+    assert abs(own.J - 1.0) > 0.05 and limit.J == pytest.approx(1.0, abs=1e-14)
+    assert own.cauchy[1] == pytest.approx(0.0, abs=1e-12) and limit.cauchy[1] == pytest.approx(0.0, abs=1e-12)
+    # an incompressible law needs no keyword (and refuses False)
+    assert uniaxial(IncompressibleNeoHookean(1.0), 1.2).cauchy[0] == pytest.approx(1.2**2 - 1 / 1.2, rel=1e-12)

@@ -5,6 +5,11 @@ whose stress is coaxial with :math:`F` (every isotropic law, and the bimodular l
 branch) has principal Cauchy stresses :math:`\sigma_a` and nominal (first Piola–Kirchhoff)
 stresses :math:`P_a = J\sigma_a/\lambda_a`.
 
+The solve is chosen explicitly: an incompressible law (``law.incompressible``) gets the
+incompressible one; a compressible law must pass ``incompressible=False`` (its own response) or
+``incompressible=True`` (its incompressible limit) — leaving it out raises ``ValueError`` instead of
+silently treating a compressible law as incompressible.
+
 **Incompressible** (``incompressible=True``, thin membrane in plane stress): :math:`J = 1` and
 :math:`\sigma = \sigma_\text{law} - pI`. Every volumetric term in this package has zero
 derivative at :math:`J = 1`, so evaluating the law there and eliminating :math:`p` from the
@@ -86,17 +91,30 @@ def _root_in_log(fun, guess: float, what: str) -> float:
     raise ValueError(f"no solution for {what}: no sign change of the traction within stretches 1e-6 .. 1e6")
 
 
-def _check_mode(material, incompressible: bool) -> None:
+def _check_mode(material, incompressible: bool | None) -> bool:
+    """The solve to use: the law's own for ``None`` on an incompressible law; an explicit choice otherwise."""
     if not callable(getattr(material, "cauchy", None)):
         raise TypeError(
             "material must be a continuum law with a cauchy(F) method (skvalve.materials); "
             f"got {type(material).__name__}"
         )
-    if not incompressible and getattr(material, "incompressible", False):
+    law_incompressible = bool(getattr(material, "incompressible", False))
+    if incompressible is None:
+        if law_incompressible:
+            return True
+        raise ValueError(
+            f"{type(material).__name__} is compressible: choose incompressible=False for its own response "
+            "(lateral faces traction free, J free) or incompressible=True for its incompressible limit "
+            "(J = 1, the volumetric part replaced by a pressure)"
+        )
+    if not isinstance(incompressible, (bool, np.bool_)):
+        raise TypeError(f"incompressible must be True, False or None; got {incompressible!r}")
+    if not incompressible and law_incompressible:
         raise ValueError(
             f"{type(material).__name__} is incompressible: its stress is defined only up to a pressure, "
-            "so use incompressible=True"
+            "so use incompressible=True (or leave it out)"
         )
+    return bool(incompressible)
 
 
 def _assemble(stretch_list: list[Array], stress_list: list[Array], shape: tuple[int, ...]) -> HomogeneousResponse:
@@ -113,9 +131,14 @@ def _positive_stretches(name: str, value: ArrayLike) -> Array:
     return value
 
 
-def uniaxial(material, stretch: ArrayLike, incompressible: bool = True) -> HomogeneousResponse:
-    r"""Uniaxial tension/compression along :math:`e_1`, lateral faces traction free."""
-    _check_mode(material, incompressible)
+def uniaxial(material, stretch: ArrayLike, incompressible: bool | None = None) -> HomogeneousResponse:
+    r"""Uniaxial tension/compression along :math:`e_1`, lateral faces traction free.
+
+    ``incompressible``: ``None`` (default) follows an incompressible law and raises ``ValueError``
+    for a compressible one, which must choose: ``False`` solves its own response (free lateral
+    stretch from :math:`P_{22} = 0`), ``True`` its incompressible limit (module docstring).
+    """
+    incompressible = _check_mode(material, incompressible)
     stretch = _positive_stretches("stretch", stretch)
     stretch_list, stress_list = [], []
     for lam in stretch.ravel():
@@ -150,9 +173,14 @@ def uniaxial(material, stretch: ArrayLike, incompressible: bool = True) -> Homog
     return _assemble(stretch_list, stress_list, stretch.shape)
 
 
-def biaxial(material, stretch1: ArrayLike, stretch2: ArrayLike, incompressible: bool = True) -> HomogeneousResponse:
-    r"""Planar biaxial stretch :math:`(\lambda_1, \lambda_2)` of a thin sheet, :math:`\sigma_{33} = 0`."""
-    _check_mode(material, incompressible)
+def biaxial(
+    material, stretch1: ArrayLike, stretch2: ArrayLike, incompressible: bool | None = None
+) -> HomogeneousResponse:
+    r"""Planar biaxial stretch :math:`(\lambda_1, \lambda_2)` of a thin sheet, :math:`\sigma_{33} = 0`.
+
+    ``incompressible`` as in :func:`uniaxial` (a compressible law must choose).
+    """
+    incompressible = _check_mode(material, incompressible)
     s1, s2 = _positive_stretches("stretch1", stretch1), _positive_stretches("stretch2", stretch2)
     try:
         s1, s2 = np.broadcast_arrays(s1, s2)
@@ -177,6 +205,6 @@ def biaxial(material, stretch1: ArrayLike, stretch2: ArrayLike, incompressible: 
     return _assemble(stretch_list, stress_list, s1.shape)
 
 
-def equibiaxial(material, stretch: ArrayLike, incompressible: bool = True) -> HomogeneousResponse:
+def equibiaxial(material, stretch: ArrayLike, incompressible: bool | None = None) -> HomogeneousResponse:
     r"""Equibiaxial stretch :math:`\lambda_1 = \lambda_2 = \lambda` of a thin sheet, :math:`\sigma_{33} = 0`."""
     return biaxial(material, stretch, stretch, incompressible=incompressible)

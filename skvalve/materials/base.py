@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike
 
 from ..kinematics import Array, as_tensor_field, determinant, right_cauchy_green
 
-__all__ = ["Hyperelastic", "VolumetricEnergy", "check_positive", "check_nonnegative"]
+__all__ = ["Hyperelastic", "VolumetricEnergy", "check_positive", "check_nonnegative", "check_scalar"]
 
 
 def _first_index(mask: Array) -> tuple[int, ...]:
@@ -47,17 +47,30 @@ def _at(index: tuple[int, ...]) -> str:
     return f" at batch index {index}" if index else ""
 
 
+def check_scalar(name: str, value: float) -> float:
+    """Return ``float(value)`` for a real number; ``TypeError`` naming the parameter for anything else.
+
+    Strings (``"2.0"``), ``None``, booleans and arrays with more than one element are rejected here,
+    at construction, instead of failing later inside a stress evaluation.
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        if isinstance(value, np.ndarray) and value.ndim == 0 and np.issubdtype(value.dtype, np.number):
+            return check_scalar(name, value.item())
+        raise TypeError(f"parameter {name} must be a real number; got {value!r} of type {type(value).__name__}")
+    return float(value)
+
+
 def check_positive(name: str, value: float) -> float:
-    """Return ``float(value)`` or raise ``ValueError`` naming the parameter."""
-    value = float(value)
+    """Return ``float(value)`` or raise ``ValueError`` (``TypeError`` for a non-number) naming the parameter."""
+    value = check_scalar(name, value)
     if not np.isfinite(value) or value <= 0.0:
         raise ValueError(f"parameter {name} must be positive and finite; got {value!r}")
     return value
 
 
 def check_nonnegative(name: str, value: float) -> float:
-    """Return ``float(value)`` or raise ``ValueError`` naming the parameter."""
-    value = float(value)
+    """Return ``float(value)`` or raise ``ValueError`` (``TypeError`` for a non-number) naming the parameter."""
+    value = check_scalar(name, value)
     if not np.isfinite(value) or value < 0.0:
         raise ValueError(f"parameter {name} must be non-negative and finite; got {value!r}")
     return value

@@ -38,7 +38,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike
 
-from .base import check_positive
+from .base import check_nonnegative, check_positive
 
 _COMPRESSION_MODES = ("paper", "buckle")
 
@@ -46,8 +46,8 @@ _COMPRESSION_MODES = ("paper", "buckle")
 def _positive(name: str, value: float) -> float:
     try:
         return check_positive(name, value)
-    except ValueError as err:
-        raise ValueError(f"ExponentialFiber: {err}") from None
+    except (TypeError, ValueError) as err:
+        raise type(err)(f"ExponentialFiber: {err}") from None
 
 
 class ExponentialFiber:
@@ -81,9 +81,10 @@ class ExponentialFiber:
         if compression not in _COMPRESSION_MODES:
             raise ValueError(f"ExponentialFiber: compression must be one of {_COMPRESSION_MODES}, got {compression!r}")
         self.compression = compression
-        self.slack_stiffness = float(slack_stiffness)
-        if not (math.isfinite(self.slack_stiffness) and self.slack_stiffness >= 0.0):
-            raise ValueError(f"ExponentialFiber: slack_stiffness must be >= 0, got {slack_stiffness}")
+        try:
+            self.slack_stiffness = check_nonnegative("slack_stiffness", slack_stiffness)
+        except (TypeError, ValueError) as err:
+            raise type(err)(f"ExponentialFiber: {err}") from None
         self.strain_c = 0.5 * (self.lambda_c**2 - 1.0)
 
     @classmethod
@@ -160,15 +161,17 @@ def normalized_force_stiffness(lam: float, params: np.ndarray) -> tuple[float, f
     beta, lambda_c, strain_c, buckle, slack = params[0], params[1], params[2], params[3], params[4]
     if buckle > 0.0 and lam < 1.0:
         return slack * (lam - 1.0), slack
+    # expm1: (exp(β e) − 1)/β keeps its precision for small β e (→ e, the linear limit)
     if lam < lambda_c:
-        expo = math.exp(beta * 0.5 * (lam * lam - 1.0))
-        return (expo - 1.0) / beta, lam * expo
+        exponent = beta * 0.5 * (lam * lam - 1.0)
+        return math.expm1(exponent) / beta, lam * math.exp(exponent)
     exp_c = math.exp(beta * strain_c)
-    return (exp_c - 1.0) / beta + lambda_c * exp_c * (lam - lambda_c), lambda_c * exp_c
+    return math.expm1(beta * strain_c) / beta + lambda_c * exp_c * (lam - lambda_c), lambda_c * exp_c
 
 
 # 12-point Gauss–Legendre rule on [−1, 1] for the strain energy of the exponential branch
-_GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(12)
+# (tuples, not arrays: numba cannot cache parallel functions that reach global arrays)
+_GAUSS_X, _GAUSS_W = (tuple(float(v) for v in table) for table in np.polynomial.legendre.leggauss(12))
 
 
 @njit(cache=True)
@@ -184,9 +187,9 @@ def normalized_energy(lam: float, params: np.ndarray) -> float:
     upper = min(lam, lambda_c)
     half, mid = 0.5 * (upper - 1.0), 0.5 * (upper + 1.0)
     energy = 0.0
-    for g in range(_GAUSS_X.size):
+    for g in range(len(_GAUSS_X)):
         s = mid + half * _GAUSS_X[g]
-        energy += _GAUSS_W[g] * (math.exp(beta * 0.5 * (s * s - 1.0)) - 1.0) / beta
+        energy += _GAUSS_W[g] * math.expm1(beta * 0.5 * (s * s - 1.0)) / beta
     energy *= half
     if lam > lambda_c:
         f_c, k_c = normalized_force_stiffness(lambda_c, params)

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..kinematics import Array
-from .base import VolumetricEnergy, check_positive
+from .base import VolumetricEnergy, check_positive, check_scalar
 from .isotropic import IsotropicInvariantLaw, Partials
 
 __all__ = ["NeoHookean", "lame_from_shear_poisson"]
@@ -31,7 +31,7 @@ __all__ = ["NeoHookean", "lame_from_shear_poisson"]
 def lame_from_shear_poisson(G: float, nu: float) -> tuple[float, float]:
     r"""Lamé constants :math:`(\mu, \lambda) = (G, 2G\nu/(1-2\nu))`; needs :math:`-1<\nu<1/2`."""
     G = check_positive("G", G)
-    nu = float(nu)
+    nu = check_scalar("nu", nu)
     if not (-1.0 < nu < 0.5):
         raise ValueError(f"parameter nu (Poisson's ratio) must lie in (-1, 0.5); got {nu!r}")
     return G, 2.0 * G * nu / (1.0 - 2.0 * nu)
@@ -46,6 +46,7 @@ class NeoHookean(IsotropicInvariantLaw):
 
     def __post_init__(self) -> None:
         check_positive("mu", self.mu)
+        check_scalar("lmbda", self.lmbda)
         # A negative lambda is admissible down to nu > -1, i.e. lambda > -2 mu / 3.
         if not (np.isfinite(self.lmbda) and self.lmbda > -2.0 * self.mu / 3.0):
             raise ValueError(f"parameter lmbda must exceed -2 mu / 3 (positive bulk modulus); got {self.lmbda!r}")

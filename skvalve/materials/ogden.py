@@ -39,7 +39,7 @@ import numpy as np
 
 from ..kinematics import Array, determinant, inverse
 from ._spectral import symmetric_eigen, trace_power_derivatives
-from .base import Hyperelastic, VolumetricEnergy, check_positive
+from .base import Hyperelastic, VolumetricEnergy, check_positive, check_scalar
 from .derivatives import PrincipalDerivatives
 from .isotropic import jacobian_second_derivative, outer
 
@@ -47,6 +47,10 @@ __all__ = ["Ogden"]
 
 
 def _as_parameter_tuple(name: str, values: float | Sequence[float]) -> tuple[float, ...]:
+    if values is None or isinstance(values, (str, bytes)):
+        raise TypeError(f"parameter {name} must be a number or a sequence of numbers; got {values!r}")
+    for i, value in enumerate(np.atleast_1d(np.asarray(values, dtype=object)).ravel()):
+        check_scalar(f"{name}[{i}]", value)
     values = np.atleast_1d(np.asarray(values, dtype=float))
     if values.ndim != 1:
         raise ValueError(f"parameter {name} must be a number or a 1-D sequence; got shape {values.shape}")
