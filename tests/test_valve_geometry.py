@@ -236,3 +236,36 @@ def test_leaflet_surfaces_of_a_brick_band(tmp_path, layers):
             assert areas.total(which) == pytest.approx(band, rel=1e-12)
             assert areas.leaflet["Septal"][which] == pytest.approx(band / 3, rel=1e-12)
             assert areas.orifice[which] == pytest.approx(scale**2 * 0.5 * n * r**2 * np.sin(2 * np.pi / n), rel=1e-12)
+
+
+def test_leaflet_surfaces_of_a_shell_band(tmp_path):
+    """S4R band: the mid surface is the shells', SPOS (outward here) the ventricular side at +t/2."""
+    radius, thickness, height, n, rows = 10.0, 0.65, 6.0, 24, 4
+    lines = ["*Node"]
+    for k in range(rows + 1):
+        for j in range(n):
+            x, y = (float(v) for v in radius * np.array([np.cos(2 * np.pi * j / n), np.sin(2 * np.pi * j / n)]))
+            lines.append(f"{1 + k * n + j}, {x!r}, {y!r}, {height * k / rows!r}")
+    lines.append("*Element, type=S4R")
+    names = ("Anterior", "Posterior", "Septal")
+    sectors = {name: [] for name in names}
+    for k in range(rows):
+        for j in range(n):
+            label = 1 + k * n + j
+            corners = [1 + k * n + j, 1 + k * n + (j + 1) % n, 1 + (k + 1) * n + (j + 1) % n, 1 + (k + 1) * n + j]
+            lines.append(", ".join(str(v) for v in [label, *corners]))
+            sectors[names[3 * j // n]].append(label)
+    for name, labels in sectors.items():
+        lines += [f"*Elset, elset={name}_Leaflet_Elements", *(f"{v}," for v in labels),
+                  f"*Shell Section, elset={name}_Leaflet_Elements, material=M", f"{thickness}, 5"]
+    lines += ["*Material, name=M", "*Surface, name=Leaflets", *(f"{name}_Leaflet_Elements, SPOS" for name in names),
+              "*Nset, nset=Annular_Nodes", *(f"{j + 1}," for j in range(n)),
+              "*Step", "*Static", "*Dsload", "Leaflets, P, 0.003", "*End Step"]
+    path = tmp_path / "shells.inp"
+    path.write_text("\n".join(lines) + "\n")
+    logging.getLogger("skvalve.io.abaqus.reader").setLevel(logging.ERROR)
+    model = read_model(path)
+    areas = valve_areas(leaflet_surfaces(model), model.nodes, annulus_nodes(model))
+    for which, r in (("ventricular", radius + thickness / 2), ("mid", radius), ("atrial", radius - thickness / 2)):
+        assert areas.total(which) == pytest.approx(height * n * 2 * r * np.sin(np.pi / n), rel=1e-12)
+        assert areas.orifice[which] == pytest.approx(0.5 * n * r**2 * np.sin(2 * np.pi / n), rel=1e-12)
