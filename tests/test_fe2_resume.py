@@ -1,5 +1,6 @@
 """Resumable FE² runs (issue 9 item 8): stop after step k, resume from the checkpoint, same result."""
 
+import meshio
 import numpy as np
 import pytest
 
@@ -8,6 +9,7 @@ from skvalve.fem.meshes import box
 from skvalve.materials.exponential_fiber import ExponentialFiber
 from skvalve.materials.neo_hookean import NeoHookean
 from skvalve.multiscale.checkpoint import Checkpoint, load_checkpoint, resume
+from skvalve.multiscale.fields import GaussPointWriter, gauss_fields
 from skvalve.multiscale.material import RVEMaterial
 from skvalve.multiscale.progress import FE2Progress
 from skvalve.networks.generate import generate
@@ -60,3 +62,15 @@ def test_checkpoint_rejects_other_files(tmp_path):
         load_checkpoint(tmp_path / "other.npz")
     with pytest.raises(FileNotFoundError):
         load_checkpoint(tmp_path / "missing.npz")
+
+
+def test_gauss_point_writer_round_trip(tmp_path):
+    solid, material = build()
+    writer = GaussPointWriter(tmp_path / "out" / "run.pvd", solid, material, {"alpha": np.array([30.0, 45.0])})
+    result = solve(solid, steps=[0.5, 1.0], progress=False, callbacks=[writer])
+    assert (tmp_path / "out" / "run.pvd").read_text().count("<DataSet") == 3
+    last = meshio.read(tmp_path / "out" / "run_0002.vtu")
+    np.testing.assert_allclose(last.point_data["displacement"], result.displacement()[:, : solid.mesh.nvertices].T)
+    sigma = gauss_fields(solid, material, result.u()).cauchy.mean(axis=2)  # (3, 3, nel)
+    np.testing.assert_allclose(last.cell_data["cauchy"][0].reshape(-1, 3, 3), sigma.transpose(2, 0, 1))
+    np.testing.assert_array_equal(last.cell_data["alpha"][0], [30.0, 45.0])
