@@ -13,6 +13,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 from skvalve.io.abaqus import read_model, trivalve_inputs
+from skvalve.papers.mathur2022.data import CHORDAE_DIAMETER, CLIP_ARM_GAP
 
 INPUTS = trivalve_inputs()
 # nodes, {element type: count}, boundary-condition data lines, pressure of the Dsload (MPa)
@@ -88,21 +89,21 @@ def test_repairs_keep_their_constraints():
 
 
 def test_chordae_sections_match_the_paper_diameters():
-    """Paper section 2.8: chordae diameters 0.65 (anterior), 0.64 (posterior), 0.71 mm (septal)."""
+    """Paper section 2.8: chordae diameters (rounded to 0.01 mm in the paper)."""
     model, _ = _model("1.0-diseased")
     areas = {s.material: s.area for s in model.sections if s.area is not None}
-    for chord, diameter in (("Anterior", 0.65), ("Posterior", 0.64), ("Septal", 0.71)):
-        assert np.sqrt(4 * areas[f"{chord}_Chordae"] / np.pi) == pytest.approx(diameter, abs=0.005)
+    for chord, diameter in CHORDAE_DIAMETER.items():
+        assert np.sqrt(4 * areas[f"{chord.capitalize()}_Chordae"] / np.pi) == pytest.approx(diameter, abs=0.005)
 
 
 def test_clip_arms_are_placed_1_4_mm_apart():
-    """Paper section 2.11: the two arms of each clip sit 1.4 mm apart. The clip part is instanced four times
-    with a translation and a rotation, so this checks the instance transform (and its sign convention)."""
+    """Paper section 2.11: the two arms of each clip sit CLIP_ARM_GAP apart. The clip part is instanced four
+    times with a translation and a rotation, so this checks the instance transform (and its sign convention)."""
     model, _ = _model("1.0-clipping")
     for first, second in (("Clip-1-1", "Clip-1-2"), ("Clip-2-1", "Clip-2-2")):
         a = model.nodes[model.node_set(f"{first}.Clip").indices]
         b = model.nodes[model.node_set(f"{second}.Clip").indices]
-        assert cKDTree(b).query(a)[0].min() == pytest.approx(1.4, abs=0.01)
+        assert cKDTree(b).query(a)[0].min() == pytest.approx(CLIP_ARM_GAP, abs=0.01)
 
 
 def test_ignored_keywords_are_listed():

@@ -15,6 +15,7 @@ from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from skvalve.io.abaqus import read_model, trivalve_inputs
+from skvalve.papers.mathur2022.data import LEAFLET_THICKNESS, TABLE2_AREAS
 from skvalve.valve.geometry import (
     annulus_nodes,
     boundary_loops,
@@ -151,7 +152,6 @@ def test_centre_region_of_a_square_is_a_central_disc():
 
 
 INPUTS = trivalve_inputs()
-PAPER_DISEASED_ORIFICE_MM2 = 870.0  # mathur2022 Table 2 (end-systole); the annulus nodes are held in place
 
 
 @pytest.mark.skipif("1.0-diseased" not in INPUTS, reason="Texas TriValve 1.0 diseased input not present")
@@ -161,9 +161,9 @@ def test_trivalve_diseased_orifice_and_leaflets():
     model = read_model(INPUTS["1.0-diseased"])
     surfaces = leaflet_surfaces(model)
     areas = valve_areas(surfaces, model.nodes, annulus_nodes(model))
-    # the paper's diseased annulus does not move (zero-displacement BCs): the undeformed mid-surface
-    # orifice must match Table 2 to within 2 %
-    assert areas.orifice["mid"] == pytest.approx(PAPER_DISEASED_ORIFICE_MM2, rel=0.02)
+    # Table 2 is at end-systole, but the diseased annulus is held in place (zero-displacement BCs on its
+    # atrial nodes): the undeformed mid-surface orifice must match Table 2 to within 2 %
+    assert areas.orifice["mid"] == pytest.approx(TABLE2_AREAS["orifice"].diseased, rel=0.02)
     assert areas.orifice["atrial"] < areas.orifice["mid"] < areas.orifice["ventricular"]
     # the annulus found geometrically on the atrial surface is the set of nodes held by the BCs
     fixed = np.unique(np.concatenate([bc.nodes for bc in model.steps[0].boundary_conditions
@@ -176,11 +176,11 @@ def test_trivalve_diseased_orifice_and_leaflets():
         mean = 0.5 * (leaflet["atrial"] + leaflet["ventricular"])
         assert leaflet["mid"] == pytest.approx(mean, rel=2e-3)
         assert leaflet["atrial"] < leaflet["mid"] < leaflet["ventricular"]
-    # paper section 2.8: leaflets 0.78 mm thick (ventricular to atrial face of each brick column)
+    # paper section 2.8: leaflet thickness (ventricular to atrial face of each brick column)
     for surface in surfaces.values():
         ventricular = model.nodes[surface.ventricular].mean(axis=1)
         atrial = model.nodes[surface.atrial].mean(axis=1)
-        assert np.median(cKDTree(atrial).query(ventricular)[0]) == pytest.approx(0.78, abs=0.01)
+        assert np.median(cKDTree(atrial).query(ventricular)[0]) == pytest.approx(LEAFLET_THICKNESS, abs=0.01)
     for name, faces in areas.centre_faces.items():
         assert areas.centre_area[name] == pytest.approx(0.1 * areas.leaflet[name]["mid"], rel=0.05)
         assert len(faces) > 10
