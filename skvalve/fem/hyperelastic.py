@@ -20,6 +20,7 @@ import numpy as np
 from ..kinematics import determinant
 from .constitutive import MaterialRegions
 from .errors import NonPositiveJacobianError
+from .fused import assemble_regions
 from .kernels import element_forces, element_gradients, element_stiffness
 from .loads import embed_3d
 from .space import Space
@@ -35,13 +36,18 @@ class HyperelasticTerm(Term):
     ----------
     space : the field's :class:`~skvalve.fem.space.Space`.
     materials : the :class:`~skvalve.fem.constitutive.MaterialRegions` assigning laws to elements.
+    fused : evaluate stress, tangent and element matrices in one compiled pass
+        (:mod:`skvalve.fem.fused`) when every law supplies its invariant or principal derivatives;
+        otherwise (and with ``False``) each law's ``pk1_and_tangent`` and the generic kernels.
     """
 
     name = "solid"
 
-    def __init__(self, space: Space, materials: MaterialRegions) -> None:
+    def __init__(self, space: Space, materials: MaterialRegions, fused: bool = True) -> None:
         self.space = space
         self.materials = materials
+        #: use the compiled stress-tangent-assembly kernel when every law has one (False: the laws' generic path)
+        self.fused = fused
 
     def connectivity(self) -> list[np.ndarray]:
         return [self.space.element_dofs]
@@ -63,11 +69,25 @@ class HyperelasticTerm(Term):
         if sp_.formulation == "up":
             p_elem = u[sp_.element_dofs[:, nb * d:]]  # (nel, nbp)
             p = np.einsum("eqa,ea->qe", sp_.Np, p_elem)
-        P, A, mixed = self.materials.evaluate(F, p, tangent)
+        fused = assemble_regions(self.materials, F, sp_, tangent, p) if self.fused else None
+        if fused is not None:  # every law compiled with its element assembly (skvalve.fem.fused)
+            P, fe, ke = fused.P, fused.forces, fused.stiffness
+        else:
+            P, fe, ke = self._generic(F, p, tangent)
         if not np.all(np.isfinite(P)):
             bad_elements = np.flatnonzero(~np.isfinite(P).all(axis=(0, 1, 2)))
             raise NonPositiveJacobianError(bad_elements, step, t, self.name)
+        internal = np.bincount(sp_.element_dofs.ravel(), fe.ravel(), minlength=sp_.n_dofs)
+        return Contribution(internal=internal, blocks=[Blocks(sp_.element_dofs, ke)])
+
+    def _generic(self, F: np.ndarray, p: np.ndarray | None, tangent: bool):
+        """P, element forces and stiffness through the laws' own ``pk1_and_tangent`` (any material)."""
+        sp_ = self.space
+        d, nb = sp_.dim, sp_.nb_u
+        P, A, mixed = self.materials.evaluate(F, p, tangent)
         fe = np.zeros((sp_.nel, sp_.ndofe))
+        if not np.all(np.isfinite(P)):
+            return P, fe, None
         fe[:, : nb * d] = element_forces(P[:d, :d], sp_.dN, sp_.dx)
         ke = None
         if tangent:
@@ -82,8 +102,7 @@ class HyperelasticTerm(Term):
                 ke[:, : nb * d, nb * d:] = coupling
                 ke[:, nb * d:, : nb * d] = coupling.transpose(0, 2, 1)
                 ke[:, nb * d:, nb * d:] = -np.einsum("eqa,qe,eqb->eab", wN, compliance, sp_.Np)
-        internal = np.bincount(sp_.element_dofs.ravel(), fe.ravel(), minlength=sp_.n_dofs)
-        return Contribution(internal=internal, blocks=[Blocks(sp_.element_dofs, ke)])
+        return P, fe, ke
 
     def commit(self) -> None:
         for region in self.materials.regions:
