@@ -24,7 +24,7 @@ from .errors import (
     TangledMeshError,
 )
 from .hyperelastic import HyperelasticTerm
-from .linsolve import available_solvers, solver_name
+from .linsolve import SolverUnavailableError, available_solvers, solver_name
 from .loads import FollowerPressure, NodalForce
 from .newton import StepEvent, solve
 from .problem import Problem
@@ -36,6 +36,6 @@ from .terms import Blocks, Contribution, Term
 __all__ = [
     "Solid", "Problem", "Term", "Blocks", "Contribution", "HyperelasticTerm", "MaterialRegions", "FollowerPressure",
     "NodalForce", "Result", "Space", "solve", "StepEvent", "SolverError", "ConvergenceError",
-    "NonPositiveJacobianError", "SingularSystemError", "OutputError", "TangledMeshError", "solver_name",
+    "NonPositiveJacobianError", "SingularSystemError", "OutputError", "TangledMeshError", "SolverUnavailableError", "solver_name",
     "available_solvers",
 ]
