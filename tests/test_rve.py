@@ -13,10 +13,11 @@ from skvalve.networks.dense_cholesky import (
     cholesky_solve_vector,
     dense_envelope,
     factor_with_shift,
+    interior_numbering,
 )
 from skvalve.networks.generate import generate
 from skvalve.networks.network import Network
-from skvalve.networks.rve import RVEState, boundary_stress, interior_numbering, solve_rve, solve_rve_batch
+from skvalve.networks.rve import RVEState, boundary_stress, solve_rve, solve_rve_batch
 from skvalve.papers.thomas2019.data import FIBER, NETWORK
 
 E_F, BETA, LAMBDA_C, DIAMETER = FIBER.E_f, FIBER.beta, FIBER.lambda_c, FIBER.diameter

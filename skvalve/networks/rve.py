@@ -56,11 +56,10 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from skvalve.materials.exponential_fiber import ExponentialFiber
 from skvalve.networks import rve_kernels as kernels
+from skvalve.networks.dense_cholesky import interior_numbering
 from skvalve.networks.network import Network
 
 
@@ -114,33 +113,6 @@ def _scale(network: Network, fiber: ExponentialFiber, psi: float, diameter: floa
     if not length > 0.0:
         raise ValueError("solve_rve: the network has no fibers (total length 0)")
     return psi * fiber.axial_rigidity / (length * area), math.sqrt(length * area / psi)
-
-
-def interior_numbering(network: Network) -> tuple[np.ndarray, np.ndarray]:
-    """Interior DOF numbering of a network and the envelope of its stiffness.
-
-    Returns ``dof`` (n_nodes,): interior node index in reverse Cuthill–McKee order of the
-    interior–interior fiber graph (−1 on the boundary), and ``first`` (3 n_free,): the column
-    where each row of K's lower envelope starts (``dense_cholesky``).  Computed once per network.
-    """
-    interior = ~network.boundary
-    n_free = int(interior.sum())
-    local = np.full(network.n_nodes, -1, dtype=np.int64)
-    local[interior] = np.arange(n_free)
-    if n_free == 0:
-        return local, np.zeros(0, dtype=np.int64)
-    ends = local[network.fibers]
-    pairs = ends[(ends[:, 0] >= 0) & (ends[:, 1] >= 0)]
-    graph = csr_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n_free, n_free))
-    order = reverse_cuthill_mckee((graph + graph.T).tocsr(), symmetric_mode=True)
-    new_index = np.empty(n_free, dtype=np.int64)
-    new_index[order] = np.arange(n_free)
-    dof = np.full(network.n_nodes, -1, dtype=np.int64)
-    dof[interior] = new_index
-    first_node = np.arange(n_free)
-    renumbered = new_index[pairs] if len(pairs) else np.zeros((0, 2), dtype=np.int64)
-    np.minimum.at(first_node, renumbered.max(axis=1), renumbered.min(axis=1))
-    return dof, np.repeat(3 * first_node, 3).astype(np.int64)
 
 
 class RVEBatch:
