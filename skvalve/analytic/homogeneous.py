@@ -46,7 +46,7 @@ _COAXIAL_RTOL = 1e-9
 
 @dataclass(frozen=True)
 class HomogeneousResponse:
-    """Principal stretches, J, principal Cauchy and nominal stresses; arrays of shape (3, *shape)."""
+    """Principal stretches, J, principal Cauchy and nominal stresses; arrays of shape ``(3, *shape)``."""
 
     stretches: Array
     J: Array

@@ -1,7 +1,7 @@
 """Constitutive laws: one law per module, each a strain energy with stress and tangent derived.
 
 Continuum laws share the interface of :class:`~skvalve.materials.base.Hyperelastic`:
-``psi(F)``, ``pk1(F)``, ``cauchy(F)``, ``tangent(F)`` with ``F`` of shape (3, 3, *batch).
+``psi(F)``, ``pk1(F)``, ``cauchy(F)``, ``tangent(F)`` with ``F`` of shape ``(3, 3, *batch)``.
 """
 
 from .base import Hyperelastic, VolumetricEnergy

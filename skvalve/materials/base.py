@@ -136,7 +136,7 @@ class Hyperelastic(ABC):
 
     @abstractmethod
     def elasticity_C(self, C: Array) -> Array:
-        r"""Material elasticity :math:`\mathbb{C} = 2\partial S/\partial C`, shape (3,3,3,3,*batch)."""
+        r"""Material elasticity :math:`\mathbb{C} = 2\partial S/\partial C`, shape ``(3, 3, 3, 3, *batch)``."""
 
     def response_C(self, C: Array) -> tuple[Array, Array]:
         """``(S, elasticity)`` together; laws override this to share intermediate work."""
@@ -153,22 +153,22 @@ class Hyperelastic(ABC):
         return self._checked("psi", self.energy_C(self._C(F)), F.shape[2:])
 
     def pk2(self, F: ArrayLike) -> Array:
-        """Second Piola–Kirchhoff stress, shape (3, 3, *batch)."""
+        """Second Piola–Kirchhoff stress, shape ``(3, 3, *batch)``."""
         F = as_tensor_field(F)
         return self._checked("pk2", self.stress_C(self._C(F)), F.shape[2:])
 
     def pk1(self, F: ArrayLike) -> Array:
-        """First Piola–Kirchhoff stress :math:`P = F S`, shape (3, 3, *batch)."""
+        """First Piola–Kirchhoff stress :math:`P = F S`, shape ``(3, 3, *batch)``."""
         F = as_tensor_field(F)
         return np.einsum("iI...,IJ...->iJ...", F, self.pk2(F))
 
     def cauchy(self, F: ArrayLike) -> Array:
-        r"""Cauchy stress :math:`\sigma = J^{-1} F S F^T`, shape (3, 3, *batch)."""
+        r"""Cauchy stress :math:`\sigma = J^{-1} F S F^T`, shape ``(3, 3, *batch)``."""
         F = as_tensor_field(F)
         return np.einsum("iI...,IJ...,jJ...->ij...", F, self.pk2(F), F) / determinant(F)
 
     def tangent(self, F: ArrayLike) -> Array:
-        r"""First elasticity tensor :math:`\partial P_{iJ}/\partial F_{kL}`, shape (3,3,3,3,*batch)."""
+        r"""First elasticity tensor :math:`\partial P_{iJ}/\partial F_{kL}`, shape ``(3, 3, 3, 3, *batch)``."""
         return self.pk1_and_tangent(F)[1]
 
     def pk1_and_tangent(self, F: ArrayLike) -> tuple[Array, Array]:

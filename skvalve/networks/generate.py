@@ -181,7 +181,7 @@ def generate(
     max_attempts : sub-seeds tried, 1 ≤ max_attempts ≤ ``MAX_ATTEMPTS``.
     ``meta`` holds the targets and the achieved α, μ (float), stretch, rotation (float), seed,
     attempt and pruned_fibers (int).
-    The result satisfies |α − alpha| ≤ alpha_tol and, for alpha ≥ 10, |μ − mu| ≤ mu_tol
+    The result satisfies ``abs(α − alpha) ≤ alpha_tol`` and, for alpha ≥ 10, ``abs(μ − mu) ≤ mu_tol``
     (axially, modulo 180°); RuntimeError if ``max_attempts`` sub-seeds all fail.
     """
     if not (0.0 <= alpha < 95.0):

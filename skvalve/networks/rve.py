@@ -9,7 +9,7 @@ exerts on the network.  Summing instead over fibers (every fiber pulls its two e
 ±f e) gives the same number at equilibrium — the interior terms vanish — and a form that is
 symmetric by construction:
 
-    Σ_boundary x ⊗ f = Σ_fibers (f/ℓ) d ⊗ d,          d = x_b − x_a, ℓ = |d|.
+    Σ_boundary x ⊗ f = Σ_fibers (f/ℓ) d ⊗ d,          d = x_b − x_a, ℓ = ‖d‖.
 
 With the dimensional scaling of Eqs. 6–7 (RVE edge γ = √(L A_f/ψ), L the total reference
 fiber length of the unit cube) Eq. 8 reads

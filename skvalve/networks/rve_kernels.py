@@ -2,7 +2,7 @@
 
 Unknowns are the positions of the interior cross-links, 3 per node, numbered in the
 bandwidth-reducing order chosen by ``rve.py`` (``dof``); forces are divided by E_f A_f (which
-cancels from the balance).  For a fiber k from node a to node b with d = x_b − x_a, ℓ = |d|,
+cancels from the balance).  For a fiber k from node a to node b with d = x_b − x_a, ℓ = ‖d‖,
 e = d/ℓ, λ = ℓ/L0 and force f(λ):
 
     residual:  r_a −= f e,   r_b += f e                      (r = ∂Π/∂x, Π = Σ L0 W(λ))
