@@ -42,19 +42,33 @@ def test_ogden_uniaxial_slope_and_small_exponent():
 
 def test_tension_only_is_slack_below_unit_stretch():
     cable = TensionOnly(CHORD, slack_fraction=1e-4)
+    k = cable.slack_stiffness
     lam = np.array([0.5, 0.999, 1.0, 1.1])
     P, dP = cable.nominal_stress(lam)
-    assert cable.slack_stiffness == pytest.approx(1e-4 * CHORD.young_modulus)
-    assert np.allclose(P[:2], cable.slack_stiffness * (lam[:2] - 1.0))
-    assert np.allclose(dP[:2], cable.slack_stiffness)
-    assert np.allclose(P[2:], CHORD.nominal_stress(lam[2:])[0])
+    assert k == pytest.approx(1e-4 * CHORD.young_modulus)
+    assert np.allclose(P[:2], k * (lam[:2] - 1.0)) and np.allclose(dP[:2], k)
+    assert np.allclose(P[2:], CHORD.nominal_stress(lam[2:])[0] + k * (lam[2:] - 1.0))
+    # a slack stretch makes a curved chain force-free in its reference state, continuous at stretch 1
+    Ps, _ = cable.nominal_stress(np.array([0.6, 1.0 - 1e-12, 1.0]), slack_stretch=0.6)
+    assert Ps[0] == 0.0 and Ps[1] == pytest.approx(Ps[2]) and Ps[2] == pytest.approx(0.4 * k)
     with pytest.raises(ValueError, match="slack_fraction"):
         TensionOnly(CHORD, slack_fraction=0.0)
     with pytest.raises(ValueError, match="stretch"):
         cable.nominal_stress(np.array([-1.0]))
 
 
-@pytest.mark.parametrize("law", [CHORD, TensionOnly(CHORD), LinearUniaxial(3.0)])
+def test_tension_only_transition_is_smooth_and_consistent():
+    cable = TensionOnly(CHORD, slack_fraction=1e-4, transition=0.01)
+    lam = np.array([0.99, 1.0, 1.002, 1.005, 1.0099, 1.01, 1.02])
+    P, dP = cable.nominal_stress(lam, slack_stretch=0.9)
+    h = 1e-8
+    fd = (cable.nominal_stress(lam + h, 0.9)[0] - cable.nominal_stress(lam - h, 0.9)[0]) / (2 * h)
+    assert np.allclose(dP, fd, rtol=1e-5, atol=1e-6 * CHORD.young_modulus)
+    # beyond the transition: the law plus the slack spring
+    assert P[-1] == pytest.approx(CHORD.nominal_stress(np.array([1.02]))[0][0] + cable.slack_stiffness * 0.12)
+
+
+@pytest.mark.parametrize("law", [CHORD, TensionOnly(CHORD), TensionOnly(CHORD, 1e-3, 0.05), LinearUniaxial(3.0)])
 def test_bar_tangent_matches_central_differences(law):
     rng = np.random.default_rng(3)
     n = 6

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..materials.uniaxial import UniaxialLaw
+from ..materials.uniaxial import TensionOnly, UniaxialLaw
 from .space import Space
 from .terms import Blocks, Contribution, Term
 
@@ -67,19 +67,25 @@ class LawAssignment:
         if n_bars and (self.index.min() < 0 or self.index.max() >= len(self.laws)):
             raise ValueError(f"law_index must lie in 0..{len(self.laws) - 1}")
 
-    def evaluate(self, stretch: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def evaluate(self, stretch: np.ndarray, slack_stretch: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Nominal stress and slope of every bar (``slack_stretch`` per bar for tension-only laws)."""
         P, dP = np.empty_like(stretch), np.empty_like(stretch)
         for k, law in enumerate(self.laws):
             mine = self.index == k
             if np.any(mine):
-                P[mine], dP[mine] = law.nominal_stress(stretch[mine])
+                if slack_stretch is None:
+                    P[mine], dP[mine] = law.nominal_stress(stretch[mine])
+                else:
+                    P[mine], dP[mine] = law.nominal_stress(stretch[mine], slack_stretch[mine])
         return P, dP
 
 
 def bar_response(x_a: np.ndarray, x_b: np.ndarray, rest_length: np.ndarray, area: np.ndarray,
-                 laws: LawAssignment, tangent: bool = True) -> BarResponse:
+                 laws: LawAssignment, tangent: bool = True, slack_stretch: np.ndarray | None = None) -> BarResponse:
     """Forces and tangents of bars with current end positions ``x_a, x_b`` of shape (n, 3) (module docstring).
 
+    ``slack_stretch``: per-bar force-free stretch of tension-only laws
+    (:class:`~skvalve.materials.uniaxial.TensionOnly`).
     Raises ``ValueError`` naming the bars whose current length is zero or not finite.
     """
     d = x_b - x_a
@@ -89,7 +95,7 @@ def bar_response(x_a: np.ndarray, x_b: np.ndarray, rest_length: np.ndarray, area
         raise ValueError(f"truss: zero or non-finite current length in bar(s) {np.flatnonzero(bad)[:10].tolist()}")
     n = d / length[:, None]
     stretch = length / rest_length
-    P, dP = laws.evaluate(stretch)
+    P, dP = laws.evaluate(stretch, slack_stretch)
     N = area * P
     f = N[:, None] * n
     forces = np.hstack([-f, f])
@@ -117,12 +123,16 @@ class Truss(Term):
     area : reference cross-section area, one number or one per bar.
     laws : a uniaxial law (:mod:`skvalve.materials.uniaxial`) or a sequence of laws with ``law_index``.
     law_index : (n_bars,) law number of each bar, with a sequence of laws.
-    rest_length : stress-free length per bar (default: the reference distance of its ends).
+    rest_length : rest length per bar (default: the reference distance of its ends); a slack cable's
+        stretch is measured against it.
+    slack_stretch : per-bar force-free stretch (<= 1) of tension-only laws, e.g. the reference distance over
+        the rest length of a collapsed chain, so that a curved chain starts stress-free.
     name : shown in error messages.
     """
 
     def __init__(self, space: Space, nodes: np.ndarray, area, laws, law_index: np.ndarray | None = None,
-                 rest_length: np.ndarray | None = None, name: str = "truss") -> None:
+                 rest_length: np.ndarray | None = None, slack_stretch: np.ndarray | None = None,
+                 name: str = "truss") -> None:
         if space.dim != 3:
             raise ValueError(f"{name}: trusses need a 3D displacement space; got dimension {space.dim}")
         nodes = np.asarray(nodes, dtype=np.int64)
@@ -152,6 +162,14 @@ class Truss(Term):
             if bad.size:
                 raise ValueError(f"{name}: {label} must be positive and finite; bar(s) {bad[:10].tolist()}")
         self.laws = LawAssignment(laws, law_index, self.n_bars)
+        self.slack_stretch = None
+        if slack_stretch is not None:
+            self.slack_stretch = np.broadcast_to(np.asarray(slack_stretch, dtype=float), (self.n_bars,)).copy()
+            if np.any(~(self.slack_stretch > 0.0) | (self.slack_stretch > 1.0)):
+                raise ValueError(f"{name}: slack_stretch must lie in (0, 1]")
+            for law in self.laws.laws:
+                if not isinstance(law, TensionOnly):
+                    raise TypeError(f"{name}: slack_stretch needs tension-only laws; got {type(law).__name__}")
 
     def connectivity(self) -> list[np.ndarray]:
         return [self.dofs]
@@ -160,7 +178,7 @@ class Truss(Term):
         """Stretch, axial force and element forces/tangents of every bar at displacement ``u``."""
         ue = u[self.dofs]
         return bar_response(self.reference[0] + ue[:, :3], self.reference[1] + ue[:, 3:], self.rest_length,
-                            self.area, self.laws, tangent)
+                            self.area, self.laws, tangent, self.slack_stretch)
 
     def assemble(self, u: np.ndarray, t: float, tangent: bool, step: int | None) -> Contribution:
         try:

@@ -25,17 +25,23 @@ evaluated as :math:`\lambda^{-1}(\operatorname{expm1}(\alpha L) - \operatorname{
 not enter: in uniaxial stress the material is taken incompressible, as Abaqus does for hyperelastic
 trusses.
 
-**Tension only (cable).** :class:`TensionOnly` keeps a law for :math:`\lambda \ge 1` and replaces it
-by a small linear slack stiffness for :math:`\lambda < 1`,
+**Tension only (cable).** :class:`TensionOnly` switches a law on in tension and keeps a small linear
+slack spring in parallel at all stretches,
 
 .. math::
 
-    P = k_s(\lambda - 1), \qquad k_s = \varepsilon\,E_0, \qquad E_0 = \frac{dP}{d\lambda}(1),
+    P = k_s(\lambda - \lambda_s) + w(\lambda)\,P_\text{law}(\max(\lambda, 1)),
+    \qquad k_s = \varepsilon\,E_0, \qquad E_0 = \frac{dP_\text{law}}{d\lambda}(1),
 
-with ``slack_fraction`` :math:`\varepsilon` (default :math:`10^{-4}`). The stress is continuous at
-:math:`\lambda = 1` (both branches vanish there); the slope jumps. The slack branch keeps a slack
-cable from being a zero-stiffness mechanism of an implicit solver while pushing back on its ends with
-at most :math:`\varepsilon E_0 A` (for :math:`\lambda \ge 0`).
+with ``slack_fraction`` :math:`\varepsilon` (default :math:`10^{-4}`), the slack stretch
+:math:`\lambda_s \le 1` at which the cable is force-free (default 1; a collapsed chordae chain uses its
+reference end-to-end distance over its path length, so the model starts stress-free) and the switch
+:math:`w = H(\lambda - 1)` (a step), or with ``transition`` :math:`\delta > 0` the C1 ramp
+:math:`w = 3x^2 - 2x^3`, :math:`x = \operatorname{clip}((\lambda - 1)/\delta, 0, 1)`, which spreads the
+jump of the slope from :math:`k_s` to :math:`k_s + E_0` over :math:`1 \le \lambda \le 1 + \delta` so that
+Newton does not cycle across the kink. The stress is continuous either way. The slack spring keeps a
+slack cable from being a zero-stiffness mechanism of an implicit solver while its force stays of order
+:math:`\varepsilon E_0 A`.
 """
 
 from __future__ import annotations
@@ -126,10 +132,11 @@ class LinearUniaxial:
 
 @dataclass(frozen=True)
 class TensionOnly:
-    """A cable: ``law`` in tension (:math:`\\lambda \\ge 1`), slack stiffness ``slack_fraction * E0`` below."""
+    """A cable: ``law`` in tension plus a parallel slack spring ``slack_fraction * E0`` (module docstring)."""
 
     law: UniaxialLaw
     slack_fraction: float = 1e-4
+    transition: float = 0.0
 
     def __post_init__(self) -> None:
         if not isinstance(self.law, UniaxialLaw):
@@ -137,6 +144,8 @@ class TensionOnly:
         check_positive("slack_fraction", self.slack_fraction)
         if self.slack_fraction >= 1.0:
             raise ValueError(f"slack_fraction must be below 1; got {self.slack_fraction!r}")
+        if not (np.isfinite(self.transition) and 0.0 <= self.transition < 1.0):
+            raise ValueError(f"transition must lie in [0, 1); got {self.transition!r}")
         P1, E0 = self.law.nominal_stress(np.ones(1))
         if abs(float(P1[0])) > 1e-12 * max(abs(float(E0[0])), 1.0) or not float(E0[0]) > 0.0:
             raise ValueError("TensionOnly needs a law that is stress-free with a positive slope at stretch 1")
@@ -151,11 +160,20 @@ class TensionOnly:
     def young_modulus(self) -> float:
         return float(self.law.nominal_stress(np.ones(1))[1][0])
 
-    def nominal_stress(self, stretch: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    def nominal_stress(self, stretch: ArrayLike, slack_stretch: ArrayLike = 1.0) -> tuple[np.ndarray, np.ndarray]:
+        """:math:`P` and :math:`dP/d\\lambda`; ``slack_stretch`` :math:`\\lambda_s \\le 1` (broadcast)."""
         lam = _positive_stretch(stretch, "TensionOnly")
-        taut = lam >= 1.0
-        Pt, dPt = self.law.nominal_stress(np.maximum(lam, 1.0))
-        P = np.where(taut, Pt, self.slack_stiffness * (lam - 1.0))
-        dP = np.where(taut, dPt, self.slack_stiffness)
+        lam_s = np.asarray(slack_stretch, dtype=float)
+        if np.any(~(lam_s > 0.0) | (lam_s > 1.0)):
+            raise ValueError("TensionOnly: slack_stretch must lie in (0, 1]")
+        k = self.slack_stiffness
+        Pl, dPl = self.law.nominal_stress(np.maximum(lam, 1.0))
+        if self.transition > 0.0:
+            x = np.clip((lam - 1.0) / self.transition, 0.0, 1.0)
+            w, dw = x * x * (3.0 - 2.0 * x), 6.0 * x * (1.0 - x) / self.transition
+        else:
+            w, dw = (lam >= 1.0).astype(float), np.zeros_like(lam)
+        P = k * (lam - lam_s) + w * Pl
+        dP = k + dw * Pl + w * dPl
         return P, dP
 

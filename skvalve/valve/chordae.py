@@ -26,7 +26,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["CollapsedChordae", "collapse_chains"]
+from ..fem.truss import LawAssignment, bar_response
+
+__all__ = ["CollapsedChordae", "collapse_chains", "tangent_on_free_nodes"]
 
 
 @dataclass
@@ -43,6 +45,7 @@ class CollapsedChordae:
     kept_nodes : node indices still used by a cable.
     interior_nodes : the collapsed chain nodes (no longer used by any element).
     dropped_bars, dropped_nodes : dangling bars and unanchored nodes removed with them (and loops).
+    bars : (n_bars, 2) the original bars (``chains`` and ``dropped_bars`` index them).
     """
 
     ends: np.ndarray
@@ -54,6 +57,7 @@ class CollapsedChordae:
     interior_nodes: np.ndarray
     dropped_bars: np.ndarray
     dropped_nodes: np.ndarray
+    bars: np.ndarray
     notes: list[str] = field(default_factory=list)
 
     def summary(self) -> str:
@@ -150,5 +154,29 @@ def collapse_chains(bars: np.ndarray, coordinates: np.ndarray, anchored: np.ndar
         ends=ends_arr, rest_length=np.asarray(rest), straight_length=straight,
         group=np.asarray(groups, dtype=np.int64), chains=chains, kept_nodes=np.unique(ends_arr),
         interior_nodes=interior_arr, dropped_bars=dropped_bars,
-        dropped_nodes=np.unique(np.asarray(dropped_nodes, dtype=np.int64)), notes=notes,
+        dropped_nodes=np.unique(np.asarray(dropped_nodes, dtype=np.int64)), bars=bars, notes=notes,
     )
+
+
+def tangent_on_free_nodes(ends: np.ndarray, coordinates: np.ndarray, rest_length: np.ndarray, area: np.ndarray,
+                          laws: LawAssignment, fixed: np.ndarray,
+                          slack_stretch: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Dense tangent of cables in their reference state on the nodes not in ``fixed``, and those nodes.
+
+    Its smallest eigenvalues show whether the network has zero-stiffness directions (mechanisms) once the
+    nodes it hangs from (leaflets, papillary tips) are held.
+    """
+    ends = np.asarray(ends, dtype=np.int64)
+    X = np.asarray(coordinates, dtype=float)
+    state = bar_response(X[ends[:, 0]], X[ends[:, 1]], rest_length, area, laws, True, slack_stretch)
+    free = np.setdiff1d(np.unique(ends), fixed)
+    local = np.full(X.shape[0], -1)
+    local[free] = np.arange(free.size)
+    dofs = (3 * local[ends][:, :, None] + np.arange(3)).reshape(-1, 6)
+    dofs[np.repeat(local[ends] < 0, 3, axis=1)] = -1
+    K = np.zeros((3 * free.size, 3 * free.size))
+    for e in range(ends.shape[0]):
+        keep = dofs[e] >= 0
+        index = dofs[e][keep]
+        K[np.ix_(index, index)] += state.matrices[e][np.ix_(keep, keep)]
+    return K, free

@@ -1,0 +1,368 @@
+r"""A whole-valve model for the implicit solver, built from an Abaqus input (Texas TriValve).
+
+:func:`valve_model` turns an :class:`~skvalve.io.abaqus.AbaqusModel` into a :class:`ValveModel`:
+
+* **leaflets**: the C3D8R bricks of the 1.0 inputs as they are, or the S4R midsurface shells of the
+  1.1 inputs extruded into ``layers`` hexes through the section thickness (:mod:`.extrude`); one
+  ``LeeSacks`` law per leaflet from the ``VUANISO_ISO`` properties :math:`(C_0, D, C_1, C_2)`
+  (mathur2022 Eq. 1 as shipped, :class:`~skvalve.materials.LeeSacks`). They run on the F-bar
+  (mean-dilatation) hexahedron :class:`~skvalve.fem.fbar.FBarTerm`, which does not lock at the
+  leaflets' :math:`\nu \approx 0.495`; ``solid="q1"`` gives the locking full-integration hexahedron
+  for comparison;
+* **chordae**: the T3D2 trusses with their section area and the 3-term Ogden law in uniaxial stress,
+  as tension-only cables (:class:`~skvalve.materials.uniaxial.TensionOnly`); chains of two-bar nodes
+  are collapsed into one cable between branch points with the chain's path length as rest length and
+  dangling bars are dropped (:mod:`.chordae`), so the implicit tangent has no zero-stiffness direction;
+* **conditions**: every ``*Boundary`` line of the chosen step (and of the model level) as a prescribed
+  displacement of mesh nodes, value times its amplitude at the step time (an amplitude-free condition
+  is held constant, Abaqus's default for dynamic steps, or ramped in a static step). A condition on a
+  shell node holds the whole fibre of extruded nodes through the thickness; rotational dofs and nodes
+  that are not part of the model (rigid clip surfaces, reference points) are skipped and noted;
+* **pressure**: each ``*Dsload`` ``P`` on an element-face surface as a follower pressure (load
+  stiffness included) on the corresponding mesh facets, magnitude times its amplitude.
+
+The solver's load factor is the **step time** (0 to the step's time period): ``solve(problem,
+steps=times)``. Mesh vertices are numbered chordae-only nodes first, then the leaflet nodes, because
+scikit-fem counts ``max(cells) + 1`` vertices. Only one step is modelled at a time (``step=``); later
+steps (clip capture and closure) and contact are the closure's business (issue 11).
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from dataclasses import dataclass, field
+
+import numpy as np
+import skfem
+
+from ..fem.amplitudes import Amplitude, SmoothStep, Tabular
+from ..fem.constitutive import MaterialRegions
+from ..fem.errors import TangledMeshError
+from ..fem.fbar import FBarTerm
+from ..fem.hyperelastic import HyperelasticTerm
+from ..fem.loads import FollowerPressure
+from ..fem.problem import Problem
+from ..fem.space import Space
+from ..fem.truss import Truss
+from ..io.abaqus import HEX_FACE_NODES, AbaqusModel
+from ..materials import LeeSacks
+from ..materials.uniaxial import OgdenUniaxial, TensionOnly
+from .chordae import CollapsedChordae, collapse_chains
+from .extrude import extrude_shell, hex_corner_jacobians
+
+__all__ = ["ValveModel", "NodalCondition", "PressureLoad", "Chordae", "valve_model"]
+
+#: scikit-fem's hexahedron node order in terms of the Abaqus (VTK) C3D8 order.
+ABAQUS_TO_SKFEM_HEX = np.array([0, 4, 3, 1, 7, 5, 2, 6])
+_SHELL_TYPES = ("S4", "S4R", "S4R5")
+_BRICK_TYPES = ("C3D8", "C3D8R", "C3D8H", "C3D8RH", "C3D8I")
+_TRUSS_TYPES = ("T3D2", "T3D2H")
+
+
+@dataclass
+class NodalCondition:
+    """Component ``component`` (0..2) of ``vertices`` prescribed to ``value`` x amplitude(t)."""
+
+    vertices: np.ndarray
+    component: int
+    value: float
+    amplitude: Amplitude | None
+    ramp_time: float | None = None
+
+    def at(self, t: float) -> float:
+        """The prescribed value at step time ``t``."""
+        if self.amplitude is not None:
+            return self.value * float(self.amplitude(t))
+        if self.ramp_time is not None:
+            return self.value * min(max(t / self.ramp_time, 0.0), 1.0)
+        return self.value
+
+
+@dataclass
+class PressureLoad:
+    """Follower pressure ``magnitude`` x amplitude(t) on mesh ``facets`` (positive pushes into the surface)."""
+
+    surface: str
+    facets: np.ndarray
+    magnitude: float
+    amplitude: Amplitude | None
+    ramp_time: float | None = None
+
+    def at(self, t: float) -> float:
+        return NodalCondition(np.empty(0, int), 0, self.magnitude, self.amplitude, self.ramp_time).at(t)
+
+
+@dataclass
+class Chordae:
+    """Cables between mesh vertices: ends, rest lengths, areas, law of each cable, and the reduction done."""
+
+    ends: np.ndarray
+    rest_length: np.ndarray
+    area: np.ndarray
+    law_index: np.ndarray
+    laws: list[OgdenUniaxial]
+    law_names: list[str]
+    reduction: CollapsedChordae
+
+
+@dataclass
+class ValveModel:
+    """Leaflet hexes, chordae cables, nodal conditions and pressures on one mesh (module docstring)."""
+
+    source: str
+    mesh: skfem.MeshHex
+    element_source: np.ndarray
+    regions: np.ndarray
+    region_names: list[str]
+    laws: list[LeeSacks]
+    chordae: Chordae
+    conditions: list[NodalCondition]
+    pressures: list[PressureLoad]
+    end_time: float
+    vertex_source: np.ndarray
+    notes: list[str] = field(default_factory=list)
+
+    def counts(self) -> dict[str, int]:
+        """Sizes: hexes, vertices, cables, collapsed chain nodes, dropped bars, conditions, pressure facets."""
+        red = self.chordae.reduction
+        return {"hexes": int(self.mesh.nelements), "vertices": int(self.mesh.p.shape[1]),
+                "cables": int(self.chordae.ends.shape[0]), "collapsed_chain_nodes": int(red.interior_nodes.size),
+                "dropped_bars": int(red.dropped_bars.size),
+                "constrained_dofs": int(sum(c.vertices.size for c in self.conditions)),
+                "pressure_facets": int(sum(p.facets.size for p in self.pressures))}
+
+    def problem(self, solid: str = "fbar", slack_fraction: float = 1e-6, transition: float = 0.01) -> Problem:
+        """A :class:`~skvalve.fem.Problem` of the model (load factor = step time).
+
+        ``solid``: ``"fbar"`` (F-bar mean-dilatation hexes, default) or ``"q1"`` (full integration, locks).
+        ``slack_fraction``: slack stiffness of the cables relative to their small-strain modulus. The default
+        :math:`10^{-6}` keeps a slack cable (:math:`10^{-6}\\times 3\\sum\\mu_i \\approx 10^{-4}` MPa for the
+        TriValve chordae) well below the leaflets' :math:`C_0 = 10^{-3}` MPa. Each cable is force-free in the
+        reference state (slack stretch = reference end-to-end distance / path length).
+        ``transition``: stretch interval over which a cable's slope ramps from slack to taut (C1, for Newton).
+        """
+        space = Space(self.mesh)
+        materials = MaterialRegions(self.mesh, list(self.laws), self.regions)
+        if solid == "fbar":
+            leaflets = FBarTerm(space, materials)
+        elif solid == "q1":
+            leaflets = HyperelasticTerm(space, materials)
+        else:
+            raise ValueError(f"solid must be 'fbar' or 'q1'; got {solid!r}")
+        problem = Problem(space, [leaflets])
+        ch = self.chordae
+        cables = [TensionOnly(law, slack_fraction, transition) for law in ch.laws]
+        slack = np.minimum(ch.reduction.straight_length / ch.rest_length, 1.0)
+        problem.add_term(Truss(space, ch.ends, ch.area, cables, ch.law_index, ch.rest_length, slack, name="chordae"))
+        for load in self.pressures:
+            problem.add_term(FollowerPressure(space, load.facets, load.at))
+        for condition in self.conditions:
+            problem.add_dirichlet(nodes=condition.vertices, value=_ValueAt(condition), components=[condition.component])
+        return problem
+
+
+class _ValueAt:
+    """``value(X, t)`` callable of a :class:`NodalCondition` for ``Problem.add_dirichlet``."""
+
+    def __init__(self, condition: NodalCondition) -> None:
+        self.condition = condition
+
+    def __call__(self, X: np.ndarray, t: float) -> np.ndarray:
+        return np.asarray(self.condition.at(t))
+
+
+def _amplitudes(abaqus: AbaqusModel) -> dict[str, Amplitude]:
+    out: dict[str, Amplitude] = {}
+    for key, amp in abaqus.amplitudes.items():
+        kind = amp.definition.upper()
+        if kind == "SMOOTH STEP":
+            out[key.upper()] = SmoothStep(tuple(amp.times), tuple(amp.values), name=amp.name)
+        elif kind == "TABULAR":
+            out[key.upper()] = Tabular(tuple(amp.times), tuple(amp.values), name=amp.name)
+        else:
+            raise ValueError(f"{amp.location}: amplitude {amp.name!r} has unsupported definition {amp.definition!r}")
+    return out
+
+
+def _leaflet_law(abaqus: AbaqusModel, name: str) -> LeeSacks:
+    material = abaqus.material(name)
+    data = material.option("anisotropic hyperelastic").data
+    if len(data) != 4:
+        raise ValueError(f"material {name!r} (line {material.line}): expected the 4 VUANISO_ISO properties "
+                         f"(C0, D, C1, C2); got {len(data)}")
+    c0, D, c1, c2 = data
+    return LeeSacks(c0, c1, c2, D)
+
+
+def _chord_law(abaqus: AbaqusModel, name: str) -> OgdenUniaxial:
+    material = abaqus.material(name)
+    option = material.option("hyperelastic")
+    n = int(option.parameters.get("n", "1"))
+    data = option.data
+    if len(data) < 2 * n:
+        raise ValueError(f"material {name!r} (line {material.line}): Ogden N={n} needs {2 * n} values; got {len(data)}")
+    return OgdenUniaxial(tuple(data[0:2 * n:2]), tuple(data[1:2 * n:2]))
+
+
+def valve_model(abaqus: AbaqusModel, layers: int = 4, step: int = 0) -> ValveModel:
+    """Build the :class:`ValveModel` of step ``step`` of ``abaqus`` (shells extruded into ``layers`` hexes)."""
+    notes: list[str] = []
+    elem_type = np.empty(abaqus.n_elements, dtype=object)
+    elem_conn: dict[int, np.ndarray] = {}
+    for block in abaqus.element_blocks:
+        elem_type[block.indices] = block.element_type
+        for index, row in zip(block.indices, block.connectivity, strict=True):
+            elem_conn[int(index)] = row
+    sections = [s for s in abaqus.sections if len(s.elements)]
+    solid_sections = [s for s in sections if elem_type[s.elements[0]] in _BRICK_TYPES + _SHELL_TYPES]
+    truss_sections = [s for s in sections if elem_type[s.elements[0]] in _TRUSS_TYPES]
+    laws = [_leaflet_law(abaqus, s.material) for s in solid_sections]
+    region_names = [s.elset for s in solid_sections]
+
+    # ---------------------------------------------------------------- leaflet cells
+    shells = any(elem_type[s.elements[0]] in _SHELL_TYPES for s in solid_sections)
+    cells, cell_region, cell_source = [], [], []
+    for r, section in enumerate(solid_sections):
+        cells.append(np.array([elem_conn[int(e)] for e in section.elements]))
+        cell_region.append(np.full(len(section.elements), r))
+        cell_source.append(np.asarray(section.elements))
+    cells_arr, regions, sources = np.vstack(cells), np.concatenate(cell_region), np.concatenate(cell_source)
+    shell_sources, ext = sources, None
+    if shells:
+        thickness = np.concatenate([np.full(len(s.elements), s.thickness) for s in solid_sections])
+        shell_nodes = np.unique(cells_arr)
+        local = np.full(abaqus.nodes.shape[0], -1)
+        local[shell_nodes] = np.arange(shell_nodes.size)
+        ext = extrude_shell(abaqus.nodes[shell_nodes], local[cells_arr], thickness, layers)
+        solid_points, hexes = ext.nodes, ext.hexes
+        regions, sources = regions[ext.shell_element], sources[ext.shell_element]
+        mid = layers // 2
+        # global node -> its vertex on the midsurface layer (chord attachments) and its whole fibre (conditions)
+        solid_vertex_of = {int(g): mid * shell_nodes.size + int(local[g]) for g in shell_nodes}
+        fibre_of = {int(g): [k * shell_nodes.size + int(local[g]) for k in range(layers + 1)] for g in shell_nodes}
+        notes.append(f"{len(cells_arr)} shells extruded into {layers} layers ({hexes.shape[0]} hexes)")
+    else:
+        solid_nodes = np.unique(cells_arr)
+        local = np.full(abaqus.nodes.shape[0], -1)
+        local[solid_nodes] = np.arange(solid_nodes.size)
+        solid_points, hexes = abaqus.nodes[solid_nodes], local[cells_arr]
+        solid_vertex_of = {int(g): int(local[g]) for g in solid_nodes}
+        fibre_of = {g: [v] for g, v in solid_vertex_of.items()}
+        det = hex_corner_jacobians(solid_points, hexes)
+        bad = np.flatnonzero(np.any(det <= 0.0, axis=1))
+        if bad.size:
+            raise TangledMeshError(sources[bad], f" in {abaqus.path}")
+
+    # ---------------------------------------------------------------- chordae
+    bars, bar_group, areas, law_names = [], [], [], []
+    for g, section in enumerate(truss_sections):
+        bars.append(np.array([elem_conn[int(e)] for e in section.elements]))
+        bar_group.append(np.full(len(section.elements), g))
+        areas.append(section.area)
+        law_names.append(section.material)
+    bars_arr = np.vstack(bars) if bars else np.zeros((0, 2), dtype=np.int64)
+    group_arr = np.concatenate(bar_group) if bar_group else np.zeros(0, dtype=np.int64)
+    step_obj = abaqus.steps[step] if abaqus.steps else None
+    bcs = list(abaqus.boundary_conditions) + (list(step_obj.boundary_conditions) if step_obj else [])
+    bc_nodes = np.unique(np.concatenate([bc.nodes for bc in bcs])) if bcs else np.zeros(0, dtype=np.int64)
+    anchored = np.union1d(np.fromiter(solid_vertex_of.keys(), dtype=np.int64), bc_nodes)
+    reduction = collapse_chains(bars_arr, abaqus.nodes, anchored, group_arr)
+    if reduction.dropped_bars.size:
+        notes.append(f"chordae: dropped {reduction.dropped_bars.size} dangling bar(s) at node(s) "
+                     f"{abaqus.node_labels[reduction.dropped_nodes][:10].tolist()} (labels)")
+    notes.append("chordae: " + reduction.summary())
+    chord_only = np.array([n for n in reduction.kept_nodes if int(n) not in solid_vertex_of], dtype=np.int64)
+
+    # ---------------------------------------------------------------- vertices: chordae-only first
+    offset = chord_only.size
+    vertex_of = {int(g): offset + v for g, v in solid_vertex_of.items()}
+    vertex_of.update({int(g): k for k, g in enumerate(chord_only)})
+    fibres = {g: [offset + v for v in vs] for g, vs in fibre_of.items()}
+    fibres.update({int(g): [k] for k, g in enumerate(chord_only)})
+    points = np.vstack([abaqus.nodes[chord_only], solid_points])
+    vertex_source = np.concatenate([chord_only, np.full(solid_points.shape[0], -1)])
+    if not shells:
+        vertex_source[offset:] = np.unique(cells_arr)
+    cells_skfem = (hexes + offset)[:, ABAQUS_TO_SKFEM_HEX]
+    mesh = skfem.MeshHex(np.ascontiguousarray(points.T), np.ascontiguousarray(cells_skfem.T))
+    ends = np.vectorize(vertex_of.__getitem__, otypes=[np.int64])(reduction.ends) if reduction.ends.size else \
+        np.zeros((0, 2), dtype=np.int64)
+    chordae = Chordae(ends, reduction.rest_length, np.asarray(areas, dtype=float)[reduction.group], reduction.group,
+                      [_chord_law(abaqus, name) for name in law_names], law_names, reduction)
+
+    # ---------------------------------------------------------------- conditions and pressure
+    amplitudes = _amplitudes(abaqus)
+    static = step_obj is not None and (step_obj.procedure or "").lower().startswith("static")
+    end_time = step_obj.time_period if step_obj else 1.0
+    ramp = end_time if static else None
+    grouped: dict[tuple, list[int]] = defaultdict(list)
+    skipped_nodes, skipped_rotations = set(), 0
+    for bc in bcs:
+        if bc.amplitude is not None and bc.amplitude.upper() not in amplitudes:
+            raise ValueError(f"{bc.location}: boundary condition uses unknown amplitude {bc.amplitude!r}")
+        for dof in range(bc.first_dof, bc.last_dof + 1):
+            if dof > 3:
+                skipped_rotations += 1
+                continue
+            for g in bc.nodes:
+                if int(g) not in fibres:
+                    skipped_nodes.add(int(g))
+                    continue
+                grouped[(dof - 1, float(bc.value), bc.amplitude)].extend(fibres[int(g)])
+    # later definitions of the same dof win: keep each (vertex, component) in its last group only
+    owner: dict[tuple[int, int], tuple] = {}
+    for key, verts in grouped.items():
+        for v in verts:
+            owner[(v, key[0])] = key
+    final: dict[tuple, list[int]] = defaultdict(list)
+    for (v, _), key in owner.items():
+        final[key].append(v)
+    conditions = [NodalCondition(np.unique(np.asarray(v, dtype=np.int64)), key[0], key[1],
+                                 amplitudes[key[2].upper()] if key[2] else None, ramp) for key, v in final.items()]
+    if skipped_nodes:
+        notes.append(f"{len(skipped_nodes)} constrained node(s) outside the model skipped (e.g. labels "
+                     f"{abaqus.node_labels[sorted(skipped_nodes)][:5].tolist()})")
+    if skipped_rotations:
+        notes.append(f"{skipped_rotations} rotational boundary dof(s) skipped (no rotations on solids)")
+    pressures = []
+    if step_obj is not None:
+        facet_index = _facet_lookup(mesh)
+        for load in step_obj.distributed_loads:
+            if load.load_type.upper() != "P":
+                notes.append(f"*Dsload type {load.load_type} on {load.surface} skipped (only P is modelled)")
+                continue
+            facets = _surface_facets(abaqus.surface(load.surface), elem_conn, vertex_of, facet_index,
+                                     ext, offset, shell_sources)
+            pressures.append(PressureLoad(load.surface, facets, load.magnitude,
+                                          amplitudes[load.amplitude.upper()] if load.amplitude else None, ramp))
+    if step_obj is not None and len(abaqus.steps) > 1:
+        notes.append(f"only step {step} ({step_obj.name!r}) modelled; {len(abaqus.steps) - 1} other step(s) not")
+    return ValveModel(str(abaqus.path), mesh, sources, regions, region_names, laws, chordae, conditions, pressures,
+                      end_time, vertex_source, notes)
+
+
+def _facet_lookup(mesh: skfem.MeshHex) -> dict[tuple[int, ...], int]:
+    facets = np.sort(mesh.facets, axis=0)
+    return {tuple(col): k for k, col in enumerate(facets.T.tolist())}
+
+
+def _surface_facets(surface, elem_conn, vertex_of, facet_index, ext, offset, shell_sources) -> np.ndarray:
+    """Mesh facet indices of an element-face surface (bricks: S1..S6; extruded shells: SPOS/SNEG)."""
+    found = []
+    for group in surface.faces:
+        face = group.face.upper()
+        if ext is not None:
+            hexes = ext.face_hexes(face)
+            corner = (4, 5, 6, 7) if face == "SPOS" else (0, 3, 2, 1)  # faces S2 / S1 of the hex
+            wanted = np.isin(shell_sources[ext.shell_element[hexes]], group.elements)
+            for h in hexes[wanted]:
+                found.append(facet_index[tuple(sorted(int(ext.hexes[h, c]) + offset for c in corner))])
+        else:
+            if face not in HEX_FACE_NODES:
+                raise ValueError(f"surface {surface.name!r}: face {face} is not a brick face S1..S6")
+            corner = HEX_FACE_NODES[face]
+            for e in group.elements:
+                conn = elem_conn[int(e)]
+                found.append(facet_index[tuple(sorted(vertex_of[int(conn[c])] for c in corner))])
+    return np.unique(np.asarray(found, dtype=np.int64))
+
