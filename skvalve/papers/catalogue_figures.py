@@ -34,7 +34,7 @@ def group_figure(entries: Sequence[CatalogueEntry]):
     for entry in entries:
         lam = np.linspace(*entry.stretch_range, 61)
         for ax, mode in zip(axes, (uniaxial, equibiaxial), strict=True):
-            line = ax.plot(lam, mode(entry.law, lam).cauchy[0], label=entry.name)[0]
+            line = ax.plot(lam, mode(entry.law, lam, incompressible=True).cauchy[0], label=entry.name)[0]
             if not entry.law.incompressible:
                 ax.plot(lam, mode(entry.law, lam, incompressible=False).cauchy[0], ls="--", color=line.get_color(),
                         lw=1)
