@@ -1,0 +1,401 @@
+r"""Frictionless penalty contact of surfaces (self-contact of leaflets): node-to-triangle, two-pass.
+
+Choice and why
+--------------
+A penalty node-to-surface method (own code, search by :class:`scipy.spatial.cKDTree`), not the IPC barrier
+of ``ipctk`` (which installs here): IPC keeps every Newton iterate intersection-free only with a
+continuous-collision-detection limit on each line-search step, and the solver's line search
+(:mod:`skvalve.fem.newton`) has no hook for a term to cap the step; its barrier also acts at a positive
+distance :math:`\hat d` with an adaptively raised stiffness, which changes the problem between load steps.
+A penalty term needs nothing from the solver beyond the :class:`~skvalve.fem.terms.Term` protocol; its
+price is a penetration :math:`p/\varepsilon` that shrinks with the penalty :math:`\varepsilon`.
+
+Formulation
+-----------
+Each quadrilateral face of the surface is split into two triangles. Every surface node :math:`s` (slave)
+is tested against the triangles :math:`(x_1, x_2, x_3)` of the same surface (master, both passes, so the
+treatment is symmetric). With :math:`m = (x_2 - x_1)\times(x_3 - x_1)`, :math:`n = m/|m|` the triangle's
+outward normal, the gap is the signed distance of the node from the triangle's plane,
+
+.. math::
+
+    g = (x_s - x_1)\cdot n ,
+
+negative when the node has passed through the face. A pair is active when the node's projection lies in
+the triangle (barycentric coordinates :math:`\ge -\epsilon`: the band extends the surface past its free edges,
+so a node that slides just past a free edge keeps its force instead of dropping it; of several triangles
+the one whose smallest barycentric coordinate is largest), :math:`-g_\text{max} < g < 0`,
+the node's own normal opposes the face (:math:`n_s\cdot n < -c`), and the triangle is not in the node's
+topological neighbourhood (``exclude_rings`` rings of faces). The energy and its derivatives are
+
+.. math::
+
+    p(h) = \begin{cases} \varepsilon h^2/(2h_0) & 0 < h < h_0 \\ \varepsilon(h - h_0/2) & h \ge h_0
+    \end{cases}, \qquad f = -A_s\,p(h)\,\nabla g, \qquad
+    K = A_s\,\big(p'(h)\,\nabla g\otimes\nabla g - p(h)\,\nabla^2 g\big),
+
+with the overlap :math:`h = -g`, :math:`A_s` the node's reference tributary area and :math:`p` the contact
+pressure: a penalty :math:`\varepsilon` whose first :math:`h_0` is rounded (``smoothing``) so that force and
+stiffness are continuous when a pair switches on (a kink there makes Newton chatter between active sets). With
+:math:`d = x_s - x_1`, :math:`a = x_2 - x_1`, :math:`b = x_3 - x_1`, :math:`\mu = |m|`,
+:math:`P = I - n\otimes n` and :math:`w = P d/\mu`:
+
+.. math::
+
+    \frac{\partial g}{\partial d} = n,\quad \frac{\partial g}{\partial a} = b\times w,\quad
+    \frac{\partial g}{\partial b} = w\times a, \qquad
+    \frac{\partial^2 g}{\partial m^2} = -\frac{(n\cdot d)P + n\otimes P d + P d\otimes n}{\mu^2},\quad
+    \frac{\partial^2 g}{\partial d\,\partial m} = \frac{P}{\mu},
+
+and :math:`\partial^2 g/\partial a_i\partial b_j = \partial^2 g/\partial m^2` mapped by
+:math:`\partial m/\partial a = -[b]_\times`, :math:`\partial m/\partial b = [a]_\times`, plus
+:math:`\varepsilon_{ijk} w_k` from the bilinearity of :math:`m`. The active set is found afresh at every
+assembly (the tangent is exact for a fixed set), so the tangent is returned as a sparse matrix on all dofs.
+
+Contact pressure (Abaqus CPRESS/CAREA): the nodal traction is the normal component of the total contact
+force on a node over its tributary area, :math:`p_i = \max(-f_i\cdot n_i, 0)/A_i`; a face's pressure is
+the mean over its nodes, and the contact area is the current area of the faces with positive pressure.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.spatial import cKDTree
+
+from .space import Space
+from .terms import Contribution, Term
+
+__all__ = ["ContactSurface", "ActivePairs", "SurfaceContact", "gap_derivatives", "oriented_quads"]
+
+
+def oriented_quads(X: np.ndarray, quads: np.ndarray, inside: np.ndarray) -> np.ndarray:
+    """Quads (n, 4) in cyclic order with the normal pointing away from the points ``inside`` (n, 3).
+
+    ``X`` (n_nodes, 3) reference coordinates; each quad's nodes are sorted by angle about its centroid in
+    its best-fit plane (so any input order works), then reversed where the normal faces ``inside``.
+    """
+    quads = np.asarray(quads, dtype=np.int64)
+    P = X[quads]  # (n, 4, 3)
+    centre = P.mean(axis=1, keepdims=True)
+    rel = P - centre
+    normal = np.cross(rel[:, 0], rel[:, 1]) + np.cross(rel[:, 1], rel[:, 2]) + np.cross(rel[:, 2], rel[:, 3]) \
+        + np.cross(rel[:, 3], rel[:, 0]) + np.cross(rel[:, 0], rel[:, 2])
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    e1 = rel[:, 0] / np.linalg.norm(rel[:, 0], axis=1, keepdims=True)
+    e2 = np.cross(normal, e1)
+    angle = np.arctan2(np.einsum("nkj,nj->nk", rel, e2), np.einsum("nkj,nj->nk", rel, e1))
+    ordered = np.take_along_axis(quads, np.argsort(angle, axis=1), axis=1)
+    Q = X[ordered]
+    area_vector = np.cross(Q[:, 2] - Q[:, 0], Q[:, 3] - Q[:, 1])
+    flip = np.einsum("ij,ij->i", area_vector, Q.mean(axis=1) - np.asarray(inside, dtype=float)) < 0.0
+    ordered[flip] = ordered[flip][:, ::-1]
+    return ordered
+
+
+@dataclass
+class ContactSurface:
+    """A surface of quadrilateral faces (cyclic, outward) split into triangles.
+
+    Attributes
+    ----------
+    quads : (n_faces, 4) scalar node indices, cyclic, normal outward.
+    triangles : (2 n_faces, 3) the triangles (face k gives triangles 2k and 2k+1).
+    nodes : (n_nodes,) the surface's nodes, sorted.
+    nodal_area : (n_nodes,) reference tributary area of each of ``nodes`` (a quarter of each adjacent face).
+    """
+
+    quads: np.ndarray
+    triangles: np.ndarray
+    nodes: np.ndarray
+    nodal_area: np.ndarray
+
+    @classmethod
+    def from_quads(cls, X: np.ndarray, quads: np.ndarray, inside: np.ndarray | None = None) -> ContactSurface:
+        """From reference coordinates ``X`` (n, 3) and faces (cyclic unless ``inside``: points behind each face)."""
+        X = np.asarray(X, dtype=float)
+        quads = np.asarray(quads, dtype=np.int64)
+        if quads.ndim != 2 or quads.shape[1] != 4 or quads.shape[0] == 0:
+            raise ValueError(f"contact surface: faces must have shape (n > 0, 4); got {quads.shape}")
+        if quads.min() < 0 or quads.max() >= X.shape[0]:
+            raise ValueError(f"contact surface: face node indices must lie in 0..{X.shape[0] - 1}")
+        if inside is not None:
+            quads = oriented_quads(X, quads, inside)
+        triangles = np.stack([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]], axis=1).reshape(-1, 3)
+        Q = X[quads]
+        area = 0.5 * np.linalg.norm(np.cross(Q[:, 2] - Q[:, 0], Q[:, 3] - Q[:, 1]), axis=1)
+        if not np.all(area > 0.0):
+            raise ValueError(f"contact surface: degenerate face(s) {np.flatnonzero(~(area > 0))[:10].tolist()}")
+        nodes, inverse = np.unique(quads, return_inverse=True)
+        nodal_area = np.bincount(inverse.ravel(), np.repeat(area / 4.0, 4), minlength=nodes.size)
+        return cls(quads, triangles, nodes, nodal_area)
+
+    @classmethod
+    def from_facets(cls, mesh, facets: np.ndarray) -> ContactSurface:
+        """From boundary facets of a scikit-fem hex mesh (oriented away from their element)."""
+        facets = np.asarray(facets, dtype=np.int64).ravel()
+        owner = mesh.f2t[0, facets]
+        inside = mesh.p[:, mesh.t[:, owner]].mean(axis=1).T
+        return cls.from_quads(mesh.p.T, mesh.facets[:, facets].T, inside)
+
+
+def gap_derivatives(xs: np.ndarray, x1: np.ndarray, x2: np.ndarray, x3: np.ndarray, hessian: bool = True):
+    """Gap ``g`` (n,), gradient (n, 12) and Hessian (n, 12, 12) w.r.t. ``[xs, x1, x2, x3]`` (module docstring)."""
+    d, a, b = xs - x1, x2 - x1, x3 - x1
+    m = np.cross(a, b)
+    mu = np.linalg.norm(m, axis=1)
+    n = m / mu[:, None]
+    g = np.einsum("ij,ij->i", d, n)
+    Pd = d - g[:, None] * n
+    w = Pd / mu[:, None]
+    grad_dab = np.hstack([n, np.cross(b, w), np.cross(w, a)])  # w.r.t. (d, a, b)
+    T = _chain_matrix()
+    grad = grad_dab @ T
+    if not hessian:
+        return g, grad, None
+    eye = np.eye(3)
+    P = eye - n[:, :, None] * n[:, None, :]
+    H_mm = -(g[:, None, None] * P + n[:, :, None] * Pd[:, None, :] + Pd[:, :, None] * n[:, None, :]) \
+        / (mu**2)[:, None, None]
+    J_m = np.concatenate([-_skew(b), _skew(a)], axis=2)  # (n, 3, 6): dm/d(a, b)
+    H = np.zeros((xs.shape[0], 9, 9))
+    H[:, :3, 3:] = (P / mu[:, None, None]) @ J_m
+    H[:, 3:, :3] = H[:, :3, 3:].transpose(0, 2, 1)
+    H[:, 3:, 3:] = J_m.transpose(0, 2, 1) @ H_mm @ J_m
+    M = np.einsum("ijk,nk->nij", _LEVI_CIVITA, w)  # d2g/da_i db_j from the bilinear m = a x b
+    H[:, 3:6, 6:] += M
+    H[:, 6:, 3:6] += M.transpose(0, 2, 1)
+    return g, grad, T.T @ H @ T
+
+
+_LEVI_CIVITA = np.zeros((3, 3, 3))
+for _i, _j, _k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
+    _LEVI_CIVITA[_i, _j, _k], _LEVI_CIVITA[_i, _k, _j] = 1.0, -1.0
+
+
+def _skew(v: np.ndarray) -> np.ndarray:
+    """[v]_x with [v]_x y = v x y, shape (n, 3, 3)."""
+    return -np.einsum("ijk,nk->nij", _LEVI_CIVITA, v)
+
+
+def _chain_matrix() -> np.ndarray:
+    """(9, 12) map from node coordinates [xs, x1, x2, x3] to (d, a, b) = (xs - x1, x2 - x1, x3 - x1)."""
+    eye = np.eye(3)
+    T = np.zeros((9, 12))
+    T[0:3, 0:3], T[0:3, 3:6] = eye, -eye
+    T[3:6, 6:9], T[3:6, 3:6] = eye, -eye
+    T[6:9, 9:12], T[6:9, 3:6] = eye, -eye
+    return T
+
+
+@dataclass
+class ActivePairs:
+    """Active node-triangle pairs at one state: slave node, triangle, gap and barycentric coordinates."""
+
+    node: np.ndarray       # (n,) scalar node index
+    triangle: np.ndarray   # (n,) triangle index into ContactSurface.triangles
+    gap: np.ndarray        # (n,) signed gap (< 0)
+    weights: np.ndarray    # (n, 3) barycentric coordinates of the projection
+
+    @property
+    def size(self) -> int:
+        return int(self.node.size)
+
+
+class SurfaceContact(Term):
+    """Frictionless penalty self-contact of one surface (two-pass node-to-triangle; module docstring).
+
+    Parameters
+    ----------
+    space : the 3D displacement :class:`~skvalve.fem.space.Space` (linear; surface nodes are its scalar dofs).
+    surface : the :class:`ContactSurface` (for contact between two bodies, give the union of their faces).
+    penalty : :math:`\\varepsilon`, pressure per unit penetration (e.g. kPa/mm), or a callable ``t -> value``.
+    max_penetration : :math:`g_\\text{max}`, deeper passes are ignored (default: the mean face edge length).
+    exclude_rings : a node never contacts faces within this many face rings of itself (self-contact).
+    opposing : :math:`c` in :math:`n_s\\cdot n < -c` (normals must oppose).
+    tolerance : barycentric band :math:`\\epsilon` past a triangle's edges (neighbours and free edges).
+    smoothing : :math:`h_0`, the overlap over which the penalty is rounded (default 1 % of the mean edge).
+    """
+
+    name = "contact"
+    symmetric = True
+
+    def __init__(self, space: Space, surface: ContactSurface, penalty, max_penetration: float | None = None,
+                 exclude_rings: int = 2, opposing: float = 0.2, tolerance: float = 0.05,
+                 smoothing: float | None = None) -> None:
+        if space.dim != 3 or space.order != 1:
+            raise ValueError("contact: needs a linear 3D displacement space")
+        if surface.nodes.max() >= space.n_scalar:
+            raise ValueError(f"contact: surface node {surface.nodes.max()} beyond the space's {space.n_scalar} nodes")
+        self.space, self.surface = space, surface
+        self.penalty = penalty if callable(penalty) else _constant(float(penalty), "penalty")
+        self.X = space.mesh.p.T
+        Q = self.X[surface.quads]
+        edges = np.linalg.norm(Q - np.roll(Q, 1, axis=1), axis=2)
+        self.max_penetration = float(edges.mean()) if max_penetration is None else float(max_penetration)
+        if not (self.max_penetration > 0.0):
+            raise ValueError(f"contact: max_penetration must be positive; got {max_penetration!r}")
+        self.opposing, self.tolerance = float(opposing), float(tolerance)
+        self.smoothing = 0.01 * float(edges.mean()) if smoothing is None else float(smoothing)
+        if not (self.smoothing >= 0.0):
+            raise ValueError(f"contact: smoothing must be >= 0; got {smoothing!r}")
+        self.area = np.zeros(space.n_scalar)
+        self.area[surface.nodes] = surface.nodal_area
+        self._excluded = _neighbourhood_keys(surface, exclude_rings)
+        self.last_pairs: ActivePairs | None = None
+        self.last_force = np.zeros(space.n_u)
+
+    # ------------------------------------------------------------------ search
+    def active_pairs(self, u: np.ndarray) -> ActivePairs:
+        """Node-triangle pairs in contact at displacement ``u`` (module docstring for the rules)."""
+        surface = self.surface
+        x = self.X + u[: self.space.n_u].reshape(-1, 3)
+        tri = surface.triangles
+        corners = x[tri]  # (nt, 3, 3)
+        centroid = corners.mean(axis=1)
+        radius = np.linalg.norm(corners - centroid[:, None], axis=2).max() + self.max_penetration
+        tree = cKDTree(centroid)
+        slaves = surface.nodes
+        lists = tree.query_ball_point(x[slaves], radius)
+        counts = np.fromiter((len(item) for item in lists), dtype=np.int64, count=slaves.size)
+        if counts.sum() == 0:
+            return _no_pairs()
+        node = np.repeat(slaves, counts)
+        triangle = np.fromiter((j for item in lists for j in item), dtype=np.int64, count=int(counts.sum()))
+        keep = ~np.isin(node * tri.shape[0] + triangle, self._excluded, assume_unique=False)
+        node, triangle = node[keep], triangle[keep]
+        c = corners[triangle]
+        m = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
+        normal = m / np.linalg.norm(m, axis=1, keepdims=True)
+        gap = np.einsum("ij,ij->i", x[node] - c[:, 0], normal)
+        ok = (gap < 0.0) & (gap > -self.max_penetration)
+        ok &= np.einsum("ij,ij->i", self._node_normals(x)[node], normal) < -self.opposing
+        node, triangle, gap, c, normal = node[ok], triangle[ok], gap[ok], c[ok], normal[ok]
+        weights = _barycentric(x[node] - gap[:, None] * normal, c)
+        inside = weights.min(axis=1)
+        ok = inside >= -self.tolerance
+        node, triangle, gap, weights, inside = node[ok], triangle[ok], gap[ok], weights[ok], inside[ok]
+        # one triangle per node: the one the projection lies deepest in (continuous across shared edges)
+        order = np.lexsort((-inside, node))
+        first = np.ones(order.size, dtype=bool)
+        first[1:] = node[order][1:] != node[order][:-1]
+        pick = order[first]
+        return ActivePairs(node[pick], triangle[pick], gap[pick], weights[pick])
+
+    def _node_normals(self, x: np.ndarray) -> np.ndarray:
+        Q = x[self.surface.quads]
+        face = np.cross(Q[:, 2] - Q[:, 0], Q[:, 3] - Q[:, 1])
+        normals = np.zeros_like(x)
+        np.add.at(normals, self.surface.quads.ravel(), np.repeat(face, 4, axis=0))
+        length = np.linalg.norm(normals, axis=1, keepdims=True)
+        return np.divide(normals, length, out=np.zeros_like(normals), where=length > 0)
+
+    # ---------------------------------------------------------------- assembly
+    def assemble(self, u: np.ndarray, t: float, tangent: bool, step: int | None) -> Contribution:
+        pairs = self.active_pairs(u)
+        return self.assemble_pairs(u, t, pairs, tangent)
+
+    def assemble_pairs(self, u: np.ndarray, t: float, pairs: ActivePairs, tangent: bool) -> Contribution:
+        """Forces and tangent of a given (fixed) active set."""
+        n_dofs = self.space.n_dofs
+        self.last_pairs = pairs
+        internal = np.zeros(n_dofs)
+        if pairs.size == 0:
+            self.last_force = np.zeros(self.space.n_u)
+            return Contribution(internal=internal, matrix=sp.csr_matrix((n_dofs, n_dofs)) if tangent else None)
+        x = self.X + u[: self.space.n_u].reshape(-1, 3)
+        tri = self.surface.triangles[pairs.triangle]
+        g, grad, hess = gap_derivatives(x[pairs.node], x[tri[:, 0]], x[tri[:, 1]], x[tri[:, 2]], tangent)
+        pressure, stiffness = self.pressure_law(-g, float(self.penalty(t)))
+        area = self.area[pairs.node]
+        dofs = (3 * np.column_stack([pairs.node, tri])[:, :, None] + np.arange(3)).reshape(-1, 12)
+        forces = -(area * pressure)[:, None] * grad
+        np.add.at(internal, dofs.ravel(), forces.ravel())
+        self.last_force = internal[: self.space.n_u].copy()
+        matrix = None
+        if tangent:
+            blocks = area[:, None, None] * (stiffness[:, None, None] * grad[:, :, None] * grad[:, None, :]
+                                            - pressure[:, None, None] * hess)
+            rows = np.repeat(dofs, 12, axis=1).ravel()
+            cols = np.tile(dofs, (1, 12)).ravel()
+            matrix = sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(n_dofs, n_dofs))
+        return Contribution(internal=internal, matrix=matrix)
+
+    def pressure_law(self, overlap: np.ndarray, penalty: float) -> tuple[np.ndarray, np.ndarray]:
+        """Contact pressure p(h) and dp/dh for overlaps ``h`` >= 0 (module docstring)."""
+        h0 = self.smoothing
+        if h0 == 0.0:
+            return penalty * overlap, np.full_like(overlap, penalty)
+        rounded = overlap < h0
+        pressure = np.where(rounded, penalty * overlap**2 / (2.0 * h0), penalty * (overlap - 0.5 * h0))
+        stiffness = np.where(rounded, penalty * overlap / h0, penalty)
+        return pressure, stiffness
+
+    # ----------------------------------------------------------------- output
+    def nodal_pressure(self, u: np.ndarray, force: np.ndarray | None = None) -> np.ndarray:
+        """Contact pressure per node (n_scalar,): compressive normal contact force over tributary area.
+
+        ``force``: the term's internal force (n_u,) at ``u`` (default: that of the last assembly)."""
+        force = self.last_force if force is None else force
+        x = self.X + u[: self.space.n_u].reshape(-1, 3)
+        normals = self._node_normals(x)
+        # ``force`` is the residual contribution (internal force): the contact acts on the node with -force
+        normal_force = np.einsum("ij,ij->i", force.reshape(-1, 3), normals)
+        pressure = np.zeros(self.space.n_scalar)
+        nodes = self.surface.nodes
+        pressure[nodes] = np.maximum(normal_force[nodes], 0.0) / self.area[nodes]
+        return pressure
+
+    def face_pressure(self, u: np.ndarray, t: float = 0.0) -> np.ndarray:
+        """Contact pressure per face (n_faces,) at ``u`` (load factor ``t`` for the penalty): mean of its nodes'."""
+        force = self.assemble(u, t, False, None).internal[: self.space.n_u]
+        return self.nodal_pressure(u, force)[self.surface.quads].mean(axis=1)
+
+    def contact_area(self, u: np.ndarray, pressure: np.ndarray | None = None, threshold: float = 0.0,
+                     t: float = 0.0) -> float:
+        """Current area of the faces whose pressure exceeds ``threshold`` (Abaqus CAREA of the surface)."""
+        pressure = self.face_pressure(u, t) if pressure is None else pressure
+        x = self.X + u[: self.space.n_u].reshape(-1, 3)
+        Q = x[self.surface.quads]
+        area = 0.5 * np.linalg.norm(np.cross(Q[:, 2] - Q[:, 0], Q[:, 3] - Q[:, 1]), axis=1)
+        return float(area[pressure > threshold].sum())
+
+
+def _constant(value: float, name: str):
+    if not (np.isfinite(value) and value > 0.0):
+        raise ValueError(f"contact: {name} must be positive and finite; got {value!r}")
+    return lambda t: value
+
+
+def _no_pairs() -> ActivePairs:
+    empty = np.zeros(0, dtype=np.int64)
+    return ActivePairs(empty, empty, np.zeros(0), np.zeros((0, 3)))
+
+
+def _barycentric(p: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Barycentric coordinates (n, 3) of points ``p`` (n, 3) in the planes of triangles ``c`` (n, 3, 3)."""
+    v0, v1, v2 = c[:, 1] - c[:, 0], c[:, 2] - c[:, 0], p - c[:, 0]
+    d00, d01, d11 = (np.einsum("ij,ij->i", v0, v0), np.einsum("ij,ij->i", v0, v1), np.einsum("ij,ij->i", v1, v1))
+    d20, d21 = np.einsum("ij,ij->i", v2, v0), np.einsum("ij,ij->i", v2, v1)
+    denom = d00 * d11 - d01 * d01
+    beta = (d11 * d20 - d01 * d21) / denom
+    gamma = (d00 * d21 - d01 * d20) / denom
+    return np.column_stack([1.0 - beta - gamma, beta, gamma])
+
+
+def _neighbourhood_keys(surface: ContactSurface, rings: int) -> np.ndarray:
+    """Sorted keys ``node * n_triangles + triangle`` of the pairs excluded as topological neighbours."""
+    n_nodes = int(surface.quads.max()) + 1
+    n_faces = surface.quads.shape[0]
+    incidence = sp.csr_matrix((np.ones(surface.quads.size), (np.repeat(np.arange(n_faces), 4),
+                                                             surface.quads.ravel())), shape=(n_faces, n_nodes))
+    near = incidence.T.tocsr()  # node -> faces containing it (ring 1)
+    for _ in range(max(rings, 1) - 1):
+        near = ((near @ incidence) @ incidence.T).tocsr()  # faces sharing a node with the current ring
+    near = near.tocoo()
+    n_triangles = surface.triangles.shape[0]
+    node, face = near.row.astype(np.int64), near.col.astype(np.int64)
+    keys = np.concatenate([node * n_triangles + 2 * face, node * n_triangles + 2 * face + 1])
+    return np.unique(keys)
