@@ -64,6 +64,23 @@ class HomogeneousBiaxial:
         P, A = self.material.pk1_and_tangent(self._F(np.asarray(stretches, dtype=float)))
         return P.mean(axis=(2, 3)), A.mean(axis=(4, 5))
 
+    def tensions_at(self, stretch_1: float, stretch_2: float, tol: float = 1e-12, max_iter: int = 30) -> np.ndarray:
+        """(T1, T2) in N/m at in-plane stretches (λ1, λ2), λ3 solved from P̄33 = 0; commits the state.
+
+        Call along a loading path (increasing stretches): each point warm-starts from the previous one.
+        """
+        lam = np.array([stretch_1, stretch_2, self.stretches[2]], dtype=float)
+        for _ in range(max_iter):
+            P, A = self.evaluate(lam)
+            if abs(P[2, 2]) <= tol * max(abs(P[0, 0]), abs(P[1, 1]), self.material.matrix.mu):
+                break
+            lam[2] -= P[2, 2] / A[2, 2, 2, 2]
+        else:
+            raise RuntimeError(f"HomogeneousBiaxial: P33 = 0 not reached at stretches ({stretch_1}, {stretch_2})")
+        self.material.commit()
+        self.stretches = lam
+        return self.thickness * np.array([P[0, 0], P[1, 1]])
+
     def solve(self, tensions, increments: int = 8, tol: float = 1e-10, max_iter: int = 30) -> list[BiaxialState]:
         """Ramp the tensions (N/m) to ``tensions`` = (T1, T2) in ``increments``; the converged states."""
         target = np.asarray(tensions, dtype=float)
