@@ -184,3 +184,12 @@ def test_fully_prescribed_problem_gives_its_reactions():
     # confined (lateral stretch 1) uniaxial stretch: P11 of the law at F = diag(1.2, 1, 1) on a unit face
     F = np.diag([1.2, 1.0, 1.0])
     assert force == pytest.approx(LAW.pk1(F)[0, 0], rel=1e-12)
+
+
+def test_vertices_without_cells_keep_their_coordinates():
+    """A vertex used by no cell (a truss-only node) is a dof at its own place, not at the origin."""
+    mesh = box(1)
+    p = np.hstack([[[2.0], [3.0], [4.0]], mesh.p])  # scikit-fem counts max(t) + 1 vertices: put it first
+    space = Space(skfem.MeshHex(p, mesh.t + 1))
+    assert np.allclose(space.dof_coordinates[:, 0], [2.0, 3.0, 4.0])
+    assert np.allclose(space.dof_coordinates[:, 1:9], mesh.p)

@@ -105,8 +105,15 @@ class Space:
     # -------------------------------------------------------------- dof helpers
     @property
     def dof_coordinates(self) -> np.ndarray:
-        """Reference coordinates of the scalar displacement dofs, shape (dim, n_scalar)."""
-        return self.basis_u.doflocs
+        """Reference coordinates of the scalar displacement dofs, shape (dim, n_scalar).
+
+        The first ``mesh.nvertices`` dofs are the vertices (Lagrange elements); their coordinates
+        come from the mesh, so vertices used by no cell (e.g. nodes of trusses only) are placed right.
+        """
+        coordinates = np.array(self.basis_u.doflocs, dtype=float)
+        nv = self.mesh.nvertices
+        coordinates[:, :nv] = self.mesh.p[:, :nv]
+        return coordinates
 
     def displacement_dofs(self, scalar_dofs: np.ndarray, components=None) -> np.ndarray:
         """Global dof numbers of the given scalar dofs and components, shape (ncomp, n)."""
