@@ -1,7 +1,8 @@
 """Command-line interface: ``skvalve materials``, ``skvalve reproduce <paper>``, ``skvalve valve info FILE``.
 
 Exit codes: 0 done; 1 ``--strict`` and a row is a regression or an unexplained disagreement; 2 bad
-arguments, an unusable ``--out`` or a paper not available yet; 130 interrupted (Ctrl-C).
+arguments, an unusable ``--out``, a paper not available yet or its input data not found (a
+``FileNotFoundError`` from ``reproduce``); 130 interrupted (Ctrl-C).
 The heavy modules (numpy, scikit-fem, matplotlib, the papers) are imported inside the commands, so
 ``skvalve --help`` and ``--version`` start fast — the one place skvalve imports inside functions.
 """
@@ -99,6 +100,8 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
             elif isinstance(item, Written):
                 written.append(item.path)
                 print(f"[{time.perf_counter() - start:6.1f} s] wrote {item.path}", file=sys.stderr, flush=True)
+    except FileNotFoundError as err:  # input data that are not shipped with skvalve (e.g. the TriValve files)
+        return _error(f"reproduce {paper.key}: {err}")
     except KeyboardInterrupt:
         figures = ", ".join(p.name for p in written) or "none"
         print(f"\nskvalve: interrupted after {time.perf_counter() - start:.0f} s. Finished: {len(rows)} rows "

@@ -125,3 +125,10 @@ def test_interrupt_in_materials_exits_130(monkeypatch, tmp_path, capsys):
     monkeypatch.setattr(catalogue_figures, "write_catalogue_figures", interrupt)
     assert main(["materials", "--out", str(tmp_path)]) == 130
     assert "interrupted" in capsys.readouterr().err
+
+
+def test_missing_input_data_is_one_line_and_exit_2(monkeypatch, tmp_path, capsys):
+    _fake_paper(monkeypatch, [Stage("reading"), FileNotFoundError("input not found: set $SKVALVE_TRIVALVE")])
+    assert main(["reproduce", "mathur2022", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1] == "skvalve: reproduce mathur2022: input not found: set $SKVALVE_TRIVALVE"
