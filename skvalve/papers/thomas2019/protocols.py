@@ -104,6 +104,7 @@ class ProtocolRun:
     path_stretch: np.ndarray  # (n, 2) edge stretches 1 + δ/L along the ramp and corrections
     path_tension: np.ndarray  # (n, 2) edge tensions (N/m) at the same states
     u: np.ndarray
+    load_factor: float  # of the final state (1 + corrections: one load-factor unit per stage)
     corrections: int
     iterations: int
     timings: dict  # solver wall time: assembly (RVE solves included), sparse solves, set-up
@@ -171,5 +172,5 @@ def run_protocol(sample: Sample, material: RVEMaterial, ratio: tuple[float, floa
         corrections += 1
         change = tensions[-1] - before  # Broyden's rank-one update of dT/dδ
         jacobian = jacobian + np.outer(change - jacobian @ step, step) / (step @ step)
-    return ProtocolRun(tuple(ratio), goal, delta, np.array(stretches), np.array(tensions), u, corrections,
+    return ProtocolRun(tuple(ratio), goal, delta, np.array(stretches), np.array(tensions), u, t, corrections,
                        iterations, timings, solid, material)
