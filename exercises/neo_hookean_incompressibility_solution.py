@@ -21,7 +21,7 @@
 # anterior leaflet microstructure", Acta Biomaterialia). Try the problem first.
 
 # %% [markdown]
-# ### Part 1 — the Cauchy stress for a principal-frame deformation (symbolic)
+# ## Part 1 — the Cauchy stress for a principal-frame deformation (symbolic)
 
 # %%
 import numpy as np
@@ -66,7 +66,7 @@ print(f"max relative difference, skvalve vs Eq. 15: {worst:.1e}")
 assert worst < 1e-13
 
 # %% [markdown]
-# ### Part 2 — $\nu \to \tfrac12$ forces $J \to 1$
+# ## Part 2 — $\nu \to \tfrac12$ forces $J \to 1$
 #
 # The trace of Eq. 15 is
 #
@@ -97,7 +97,7 @@ assert limit == 0
 # $c = \big[\operatorname{tr}\sigma - G(\lambda_1^2+\lambda_2^2+\lambda_3^2-3)\big]/(3G)$ evaluated on the
 # incompressible limit ($J = 1$, $\nu = \tfrac12$).
 #
-# ### Part 3 — numerical check under a fixed uniaxial load
+# ## Part 3 — numerical check under a fixed uniaxial load
 #
 # In the limit the material is incompressible neo-Hookean, whose uniaxial nominal stress is
 # $P = G(\lambda - \lambda^{-2})$. For $P = 1$ kPa and $G = 2.1$ kPa that fixes $\lambda$, the Cauchy stress
