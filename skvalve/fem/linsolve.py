@@ -113,11 +113,14 @@ class SolverStatistics:
 class _Pardiso:
     """Thin ctypes driver of MKL PARDISO (zero-based CSR, phases called explicitly)."""
 
-    def __init__(self, mtype: int) -> None:
-        import pypardiso  # optional dependency, loaded only when this backend is used
+    _function = None  # the ctypes ``pardiso`` of mkl_rt, located once per process (pypardiso globs for it)
 
-        self._library = pypardiso.PyPardisoSolver(mtype=mtype)  # locates and loads mkl_rt
-        self._pardiso = self._library._mkl_pardiso
+    def __init__(self, mtype: int) -> None:
+        if _Pardiso._function is None:
+            import pypardiso  # optional dependency, loaded only when this backend is used
+
+            _Pardiso._function = pypardiso.PyPardisoSolver(mtype=mtype)._mkl_pardiso
+        self._pardiso = _Pardiso._function
         self.mtype = mtype
         self.pt = np.zeros(64, dtype=np.int64)
         self.iparm = np.zeros(64, dtype=np.int32)
