@@ -14,6 +14,7 @@ from skvalve.networks.dense_cholesky import (
     dense_envelope,
     factor_with_shift,
     interior_numbering,
+    node_cholesky_in_place,
 )
 from skvalve.networks.generate import generate
 from skvalve.networks.network import Network
@@ -264,6 +265,24 @@ def test_envelope_cholesky_against_numpy():
     y = rhs[:, 0].copy()
     cholesky_solve_vector(work, 40, first, y)
     np.testing.assert_allclose(y, np.linalg.solve(banded, rhs[:, 0]), rtol=1e-10, atol=1e-12)
+
+
+def test_node_blocked_cholesky_matches_numpy():
+    """3 unknowns per node sharing the envelope start: the node-blocked factor is the scalar one."""
+    rng = np.random.default_rng(3)
+    first = np.repeat(3 * np.maximum(np.arange(12) - rng.integers(0, 5, size=12), 0), 3).astype(np.int64)
+    matrix = np.zeros((36, 36))
+    for i in range(36):
+        matrix[i, first[i] : i] = rng.normal(size=i - first[i])
+    matrix = matrix + matrix.T + 12 * np.eye(36)
+    work = np.full((36, 36), np.nan)
+    assert factor_with_shift(np.tril(matrix), work, 36, first, True)
+    rhs = rng.normal(size=(36, 9))
+    y = rhs.copy()
+    cholesky_solve(work, 36, first, y)
+    np.testing.assert_allclose(y, np.linalg.solve(matrix, rhs), rtol=1e-10, atol=1e-12)
+    indefinite = matrix - (np.linalg.eigvalsh(matrix)[0] + 1.0) * np.eye(36)
+    assert not node_cholesky_in_place(np.tril(indefinite), 36, first)
 
 
 def test_interior_numbering_envelope_holds_every_coupling(network):

@@ -51,6 +51,38 @@ def cholesky_in_place(a: np.ndarray, n: int, first: np.ndarray) -> bool:
 
 
 @njit(cache=True, fastmath=FAST)
+def node_cholesky_in_place(a: np.ndarray, n: int, first: np.ndarray) -> bool:
+    """:func:`cholesky_in_place` for 3 unknowns per node: rows 3I, 3I+1, 3I+2 share ``first``.
+
+    The three rows of a node are reduced against row j together (three dot products sharing the
+    loads of row j), which about halves the time of the scalar loop; same formulas otherwise.
+    """
+    for I in range(0, n, 3):
+        f = first[I]
+        for j in range(f, I):
+            t0, t1, t2 = a[I, j], a[I + 1, j], a[I + 2, j]
+            for k in range(max(f, first[j]), j):
+                ajk = a[j, k]
+                t0 -= a[I, k] * ajk
+                t1 -= a[I + 1, k] * ajk
+                t2 -= a[I + 2, k] * ajk
+            d = a[j, j]
+            a[I, j], a[I + 1, j], a[I + 2, j] = t0 / d, t1 / d, t2 / d
+        for i in range(I, I + 3):  # the node's own 3×3 diagonal block
+            for j in range(I, i + 1):
+                t = a[i, j]
+                for k in range(f, j):
+                    t -= a[i, k] * a[j, k]
+                if j < i:
+                    a[i, j] = t / a[j, j]
+                elif t > 0.0:
+                    a[i, i] = math.sqrt(t)
+                else:
+                    return False
+    return True
+
+
+@njit(cache=True, fastmath=FAST)
 def cholesky_solve(factor: np.ndarray, n: int, first: np.ndarray, b: np.ndarray) -> None:
     """Solve L Lᵀ Y = B in place for all columns of B (n, r) in one blocked sweep.
 
@@ -95,11 +127,12 @@ def cholesky_solve_vector(factor: np.ndarray, n: int, first: np.ndarray, b: np.n
 
 
 @njit(cache=True)
-def factor_with_shift(matrix, work, n, first):
+def factor_with_shift(matrix, work, n, first, node_blocks=False):
     """Cholesky of K; on failure K + τ·max(diag) I with τ = 1e-10, 1e-8, ... (Levenberg step).
 
     Reads the lower envelope of ``matrix``, writes the factor into ``work``.  Returns True if K
-    itself was positive definite.
+    itself was positive definite.  ``node_blocks``: 3 unknowns per node sharing ``first``
+    (:func:`node_cholesky_in_place`).
     """
     scale = 0.0
     for i in range(n):
@@ -110,7 +143,8 @@ def factor_with_shift(matrix, work, n, first):
             for j in range(first[i], i + 1):
                 work[i, j] = matrix[i, j]
             work[i, i] += shift * scale
-        if cholesky_in_place(work, n, first):
+        factored = node_cholesky_in_place(work, n, first) if node_blocks else cholesky_in_place(work, n, first)
+        if factored:
             return shift == 0.0
         shift = 1e-10 if shift == 0.0 else 100.0 * shift
         if shift > 1e3:

@@ -149,26 +149,32 @@ def solve_network(X, fibers, rest_length, dof, first, n_free, x, params, tol, ma
     relative = np.inf
     iterations = 0
     previous_norm = 0.0  # forces a factorisation on the first step
+    known = False  # residual and norms at x already known (from the accepted trial step)
     for iterations in range(max_iter + 1):
-        force_norm, stiffness_norm, min_length = assemble(
-            x, fibers, rest_length, dof, first, params, residual, matrix, fiber_data, True, False
-        )
+        if not known:
+            force_norm, stiffness_norm, min_length = assemble(
+                x, fibers, rest_length, dof, first, params, residual, matrix, fiber_data, True, False
+            )
         if min_length < 1e-12:
             return COLLAPSED, iterations, relative
         res_norm = math.sqrt(np.sum(residual * residual))
         relative = res_norm / force_norm if force_norm > 0.0 else 0.0
-        if res_norm <= max(tol * force_norm, ROUNDOFF * stiffness_norm):
-            positive_definite = factor_with_shift(matrix, work, n, first)  # for the tangent
+        converged = res_norm <= max(tol * force_norm, ROUNDOFF * stiffness_norm)
+        # chord step (reuse the factor) while the residual falls fast, else refactor
+        chord = res_norm < CHORD_RATIO * previous_norm
+        if known and (converged or not (chord or iterations == max_iter)):
+            assemble(x, fibers, rest_length, dof, first, params, residual, matrix, fiber_data, True, False)
+        if converged:
+            positive_definite = factor_with_shift(matrix, work, n, first, True)  # for the tangent
             status = CONVERGED if positive_definite else INDEFINITE
             break
         if iterations == max_iter:
             break
-        # chord step (reuse the factor) while the residual falls fast, else refactor; an
-        # indefinite K (compressed fibers) is replaced by its convexified version
-        if not res_norm < CHORD_RATIO * previous_norm:
-            if not factor_with_shift(matrix, work, n, first):
+        # an indefinite K (compressed fibers) is replaced by its convexified version
+        if not chord:
+            if not factor_with_shift(matrix, work, n, first, True):
                 assemble(x, fibers, rest_length, dof, first, params, residual, matrix, fiber_data, True, True)
-                factor_with_shift(matrix, work, n, first)
+                factor_with_shift(matrix, work, n, first, True)
         previous_norm = res_norm
         for i in range(n):
             step[i] = -residual[i]
@@ -176,9 +182,15 @@ def solve_network(X, fibers, rest_length, dof, first, n_free, x, params, tol, ma
         # full step if it lowers the residual (or we are already close); otherwise Armijo
         # backtracking on the energy Π, for which the step is a descent direction
         _trial_positions(x, dof, step, 1.0, x_trial)
-        assemble(x_trial, fibers, rest_length, dof, first, params, trial_residual, matrix, fiber_data, False, False)
+        trial_norms = assemble(
+            x_trial, fibers, rest_length, dof, first, params, trial_residual, matrix, fiber_data, False, False
+        )
         trial_res = math.sqrt(np.sum(trial_residual * trial_residual))
-        if not (trial_res < res_norm or relative < 1e-6):
+        known = trial_res < res_norm or relative < 1e-6
+        if known:  # the full step is taken: its residual is the next iteration's
+            residual[:] = trial_residual
+            force_norm, stiffness_norm, min_length = trial_norms
+        else:
             energy = network_energy(x, fibers, rest_length, params)
             slope = 0.0
             for i in range(n):
