@@ -104,3 +104,34 @@ def test_collapsed_chordae_have_no_zero_stiffness_direction(models, key):
                                       np.setdiff1d(np.unique(bars[incident]), [node]))
     assert free0.tolist() == [node]
     assert np.linalg.eigvalsh(K0)[0] <= 1e-12 * np.abs(K0).max()
+
+
+def test_diseased_pressure_and_conditions_follow_the_input(models):
+    """Total follower-pressure force in the reference state = -p(t) x the vector area of the Abaqus faces (outward
+    by the right-hand rule of the face definitions), with p(t) = 0.00567 MPa x SMOOTH STEP(0.5, 1.5); the papillary
+    tips are at -14 mm x SMOOTH STEP(0, 0.5)."""
+    if "1.0-diseased" not in models:
+        pytest.skip("1.0 diseased not present")
+    from skvalve.fem import FollowerPressure
+    from skvalve.io.abaqus import HEX_FACE_NODES
+
+    abaqus, model = models["1.0-diseased"]
+    problem = model.problem()
+    pressure = next(term for term in problem.terms if isinstance(term, FollowerPressure))
+    u = np.zeros(problem.space.n_dofs)
+    total = pressure.assemble(u, 1.5, False).external.reshape(-1, 3).sum(axis=0)
+    connectivity = {int(i): row for b in abaqus.element_blocks for i, row in zip(b.indices, b.connectivity,
+                                                                                  strict=True)}
+    area = np.zeros(3)
+    for group in abaqus.surface("Leaflet_Surfaces_Outer").faces:
+        for e in group.elements:
+            x = abaqus.nodes[connectivity[int(e)][list(HEX_FACE_NODES[group.face])]]
+            area += 0.5 * np.cross(x[2] - x[0], x[3] - x[1])
+    assert np.allclose(total, -0.00567 * area, rtol=1e-10, atol=1e-12 * np.abs(area).max())
+    half = 0.5 ** 3 * (10 - 15 * 0.5 + 6 * 0.25)  # the smooth step half-way
+    assert np.allclose(pressure.assemble(u, 1.0, False).external.reshape(-1, 3).sum(axis=0), -0.00567 * half * area)
+    assert np.allclose(pressure.assemble(u, 0.5, False).external, 0.0)
+    dofs, values = problem.constrained(0.25)
+    tips = np.flatnonzero(np.isclose(values, -14.0 * half))
+    assert tips.size == 32 and np.all(dofs[tips] % 3 == 2)
+    assert np.allclose(np.delete(values, tips), 0.0)

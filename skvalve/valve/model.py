@@ -94,7 +94,8 @@ class PressureLoad:
 
 @dataclass
 class Chordae:
-    """Cables between mesh vertices: ends, rest lengths, areas, law of each cable, and the reduction done."""
+    """Cables between mesh vertices: ends, rest lengths, areas, law of each cable, the reduction done, and each
+    cable's force-free slack stretch (reference end-to-end distance / rest length)."""
 
     ends: np.ndarray
     rest_length: np.ndarray
@@ -103,6 +104,7 @@ class Chordae:
     laws: list[OgdenUniaxial]
     law_names: list[str]
     reduction: CollapsedChordae
+    slack_stretch: np.ndarray
 
 
 @dataclass
@@ -131,6 +133,38 @@ class ValveModel:
                 "constrained_dofs": int(sum(c.vertices.size for c in self.conditions)),
                 "pressure_facets": int(sum(p.facets.size for p in self.pressures))}
 
+    def submodel(self, regions: list[int]) -> ValveModel:
+        """The leaflets of the given region numbers alone: their hexes, conditions and pressure, and the cables
+        whose two ends lie on them (cables to chordae-only nodes are dropped). For smoke tests and studies."""
+        keep = np.isin(self.regions, regions)
+        if not np.any(keep):
+            raise ValueError(f"no hexes in regions {regions}; the model has regions 0..{len(self.region_names) - 1}")
+        cells = self.mesh.t[:, keep]
+        used = np.unique(cells)
+        new = np.full(self.mesh.p.shape[1], -1)
+        new[used] = np.arange(used.size)
+        mesh = skfem.MeshHex(np.ascontiguousarray(self.mesh.p[:, used]), np.ascontiguousarray(new[cells]))
+        ch = self.chordae
+        inside = np.all(new[ch.ends] >= 0, axis=1)
+        chordae = Chordae(new[ch.ends[inside]], ch.rest_length[inside], ch.area[inside], ch.law_index[inside],
+                          ch.laws, ch.law_names, ch.reduction, ch.slack_stretch[inside])
+        conditions = [NodalCondition(new[c.vertices[new[c.vertices] >= 0]], c.component, c.value, c.amplitude,
+                                     c.ramp_time) for c in self.conditions]
+        conditions = [c for c in conditions if c.vertices.size]
+        lookup = _facet_lookup(mesh)
+        pressures = []
+        for load in self.pressures:
+            corners = new[self.mesh.facets[:, load.facets]]
+            mine = np.all(corners >= 0, axis=0)
+            facets = [lookup.get(tuple(sorted(col))) for col in corners[:, mine].T.tolist()]
+            facets = np.array([f for f in facets if f is not None], dtype=np.int64)
+            if facets.size:
+                pressures.append(PressureLoad(load.surface, facets, load.magnitude, load.amplitude, load.ramp_time))
+        names = ", ".join(self.region_names[r] for r in regions)
+        return ValveModel(self.source, mesh, self.element_source[keep], self.regions[keep], self.region_names,
+                          self.laws, chordae, conditions, pressures, self.end_time, self.vertex_source[used],
+                          self.notes + [f"submodel of {names}: {int(inside.sum())} of {inside.size} cables kept"])
+
     def problem(self, solid: str = "fbar", slack_fraction: float = 1e-6, transition: float = 0.01) -> Problem:
         """A :class:`~skvalve.fem.Problem` of the model (load factor = step time).
 
@@ -152,8 +186,9 @@ class ValveModel:
         problem = Problem(space, [leaflets])
         ch = self.chordae
         cables = [TensionOnly(law, slack_fraction, transition) for law in ch.laws]
-        slack = np.minimum(ch.reduction.straight_length / ch.rest_length, 1.0)
-        problem.add_term(Truss(space, ch.ends, ch.area, cables, ch.law_index, ch.rest_length, slack, name="chordae"))
+        if ch.ends.shape[0]:
+            problem.add_term(Truss(space, ch.ends, ch.area, cables, ch.law_index, ch.rest_length, ch.slack_stretch,
+                                   name="chordae"))
         for load in self.pressures:
             problem.add_term(FollowerPressure(space, load.facets, load.at))
         for condition in self.conditions:
@@ -288,7 +323,8 @@ def valve_model(abaqus: AbaqusModel, layers: int = 4, step: int = 0) -> ValveMod
     ends = np.vectorize(vertex_of.__getitem__, otypes=[np.int64])(reduction.ends) if reduction.ends.size else \
         np.zeros((0, 2), dtype=np.int64)
     chordae = Chordae(ends, reduction.rest_length, np.asarray(areas, dtype=float)[reduction.group], reduction.group,
-                      [_chord_law(abaqus, name) for name in law_names], law_names, reduction)
+                      [_chord_law(abaqus, name) for name in law_names], law_names, reduction,
+                      np.minimum(reduction.straight_length / reduction.rest_length, 1.0))
 
     # ---------------------------------------------------------------- conditions and pressure
     amplitudes = _amplitudes(abaqus)
