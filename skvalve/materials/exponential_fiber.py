@@ -89,7 +89,7 @@ class ExponentialFiber:
 
     @classmethod
     def from_diameter(cls, E_f: float, diameter: float, beta: float, lambda_c: float, **kwargs) -> ExponentialFiber:
-        """Fiber with a circular cross-section A_f = π d²/4 (the paper uses d = 450 nm)."""
+        """Fiber with a circular cross-section A_f = π d²/4 (thomas2019: ``papers.thomas2019.data.FIBER.diameter``)."""
         diameter = _positive("diameter", diameter)
         return cls(E_f, math.pi * diameter**2 / 4.0, beta, lambda_c, **kwargs)
 
@@ -162,11 +162,12 @@ def normalized_force_stiffness(lam: float, params: np.ndarray) -> tuple[float, f
     if buckle > 0.0 and lam < 1.0:
         return slack * (lam - 1.0), slack
     # expm1: (exp(β e) − 1)/β keeps its precision for small β e (→ e, the linear limit)
+    # (one transcendental per call: exp = expm1 + 1, correctly rounded to within an ulp)
     if lam < lambda_c:
-        exponent = beta * 0.5 * (lam * lam - 1.0)
-        return math.expm1(exponent) / beta, lam * math.exp(exponent)
-    exp_c = math.exp(beta * strain_c)
-    return math.expm1(beta * strain_c) / beta + lambda_c * exp_c * (lam - lambda_c), lambda_c * exp_c
+        growth = math.expm1(beta * 0.5 * (lam * lam - 1.0))
+        return growth / beta, lam * (growth + 1.0)
+    growth_c = math.expm1(beta * strain_c)
+    return growth_c / beta + lambda_c * (growth_c + 1.0) * (lam - lambda_c), lambda_c * (growth_c + 1.0)
 
 
 # 12-point Gauss–Legendre rule on [−1, 1] for the strain energy of the exponential branch
