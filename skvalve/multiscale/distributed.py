@@ -78,6 +78,7 @@ class ChunkTrial:
     state: ChunkState
     cauchy: np.ndarray  # (n, 3, 3)
     tangent: np.ndarray  # (n, 3, 3, 3, 3)
+    seconds: float = 0.0  # the solve's wall time on the worker
 
 
 @dataclass(frozen=True)
@@ -110,6 +111,7 @@ def _solve_chunk(built: tuple[RVEBatch, _ChunkInput], committed: ChunkTrial | No
         batch.has_state = np.ones(len(batch.networks), dtype=bool)
     else:
         batch.has_state = np.zeros(len(batch.networks), dtype=bool)
+    start = time.perf_counter()
     try:
         out = batch.solve(F, update_state=False)
     except RuntimeError as err:
@@ -119,11 +121,11 @@ def _solve_chunk(built: tuple[RVEBatch, _ChunkInput], committed: ChunkTrial | No
             text = f"RVE of element {r // spec.n_points}, quadrature point {r % spec.n_points}: {text}"
         raise RVEFailure(f"DistributedRVEMaterial: {text}") from err
     state = ChunkState(out["x"], np.array(F, copy=True), out["sensitivity"], out["stretch"])
-    return ChunkTrial(state, out["cauchy"], out["tangent"])
+    return ChunkTrial(state, out["cauchy"], out["tangent"], time.perf_counter() - start)
 
 
-def _stresses(trial: ChunkTrial) -> tuple[np.ndarray, np.ndarray]:
-    return trial.cauchy, trial.tangent
+def _stresses(trial: ChunkTrial) -> tuple[np.ndarray, np.ndarray, float]:
+    return trial.cauchy, trial.tangent, trial.seconds
 
 
 def _state_of(trial: ChunkTrial) -> ChunkState:
@@ -199,6 +201,7 @@ class DistributedRVEMaterial(RVEMaterial):
         self.networks = networks
         self.n_rves = self.n_elements * self.n_points
         self.solves, self.solve_seconds = 0, 0.0
+        self.worker_seconds = 0.0  # per evaluation the slowest chunk's solve time on its worker, summed
         self.client = client
         element_bounds = np.linspace(0, self.n_elements, int(n_chunks) + 1).round().astype(int)
         self.rve_bounds = element_bounds * self.n_points  # chunk c holds RVEs rve_bounds[c]:rve_bounds[c + 1]
@@ -272,6 +275,7 @@ class DistributedRVEMaterial(RVEMaterial):
                   for c, s in enumerate(self._slices())]
         parts = self.client.gather([self._submit(c, _stresses, trial) for c, trial in enumerate(trials)])
         self.solve_seconds += time.perf_counter() - start
+        self.worker_seconds += max(p[2] for p in parts)
         self.solves += self.n_rves
         out = {"cauchy": np.concatenate([p[0] for p in parts]), "tangent": np.concatenate([p[1] for p in parts])}
         self._trial = (np.array(F, copy=True), trials, out)
