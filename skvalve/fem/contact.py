@@ -24,7 +24,8 @@ outward normal, the gap is the signed distance of the node from the triangle's p
 negative when the node has passed through the face. A pair is active when the node's projection lies in
 the triangle (barycentric coordinates :math:`\ge -\epsilon`: the band extends the surface past its free edges,
 so a node that slides just past a free edge keeps its force instead of dropping it; of several triangles
-the one whose smallest barycentric coordinate is largest), :math:`-g_\text{max} < g < 0`,
+the one it had at the previous search while it stays valid, else the one whose smallest barycentric
+coordinate is largest), :math:`-g_\text{max} < g < 0`,
 the node's own normal opposes the face (:math:`n_s\cdot n < -c`), and the triangle is not in the node's
 topological neighbourhood (``exclude_rings`` rings of faces). The energy and its derivatives are
 
@@ -245,6 +246,7 @@ class SurfaceContact(Term):
         self.area[surface.nodes] = surface.nodal_area
         self._excluded = _neighbourhood_keys(surface, exclude_rings)
         self.last_pairs: ActivePairs | None = None
+        self._previous = np.full(space.n_scalar, -1, dtype=np.int64)  # triangle of each node at the last search
         self.last_force = np.zeros(space.n_u)
 
     # ------------------------------------------------------------------ search
@@ -261,6 +263,7 @@ class SurfaceContact(Term):
         lists = tree.query_ball_point(x[slaves], radius)
         counts = np.fromiter((len(item) for item in lists), dtype=np.int64, count=slaves.size)
         if counts.sum() == 0:
+            self._previous[:] = -1
             return _no_pairs()
         node = np.repeat(slaves, counts)
         triangle = np.fromiter((j for item in lists for j in item), dtype=np.int64, count=int(counts.sum()))
@@ -277,11 +280,16 @@ class SurfaceContact(Term):
         inside = weights.min(axis=1)
         ok = inside >= -self.tolerance
         node, triangle, gap, weights, inside = node[ok], triangle[ok], gap[ok], weights[ok], inside[ok]
-        # one triangle per node: the one the projection lies deepest in (continuous across shared edges)
-        order = np.lexsort((-inside, node))
+        # one triangle per node: the one it had at the last search if still valid (a node on a vertex or an
+        # edge of non-coplanar triangles would otherwise flip between them from one Newton iterate to the
+        # next), else the one its projection lies deepest in
+        kept = self._previous[node] == triangle
+        order = np.lexsort((-inside, ~kept, node))
         first = np.ones(order.size, dtype=bool)
         first[1:] = node[order][1:] != node[order][:-1]
         pick = order[first]
+        self._previous[:] = -1
+        self._previous[node[pick]] = triangle[pick]
         return ActivePairs(node[pick], triangle[pick], gap[pick], weights[pick])
 
     def _node_normals(self, x: np.ndarray) -> np.ndarray:

@@ -1,0 +1,97 @@
+"""``skvalve reproduce mathur2022``: Tables 2–3 of the diseased Texas TriValve 1.0 at end-systole.
+
+Default run (a few minutes): reads the shipped diseased input, builds the implicit model (F-bar leaflet
+hexes, collapsed chordae cables, amplitudes, follower pressure, leaflet self-contact) and compares the
+**orifice area**, which the model fixes (the annulus nodes are held, so it is the same open and closed),
+with Table 2; it measures the leaflet areas of the open configuration (reported beside the paper's
+end-systolic values, with that difference stated). It does **not** close the valve: on 2 cores the full
+closure takes far longer than a default run (``benchmarks/trivalve_closure.py``).
+
+``full=True``: the implicit closure from the open configuration to end-systole
+(:func:`skvalve.valve.closure.run_closure`) and all Table 2 (orifice, leaflet, coaptation area) and
+Table 3 (centre stresses) rows of the diseased column, with a VTU series in ``out``. When the closure stops
+early, the rows are those of the last converged state, marked with the step time reached.
+
+The model files (Mathur et al. 2022, CC BY-NC-SA 4.0) are never copied; without them the run ends with a
+message and exit code 2 (``$SKVALVE_TRIVALVE`` names the .inp file or its folder).
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+
+from ...io.abaqus import trivalve_input
+from ...valve.closure import ClosureOptions, closure_setup, run_closure, write_log
+from ...valve.outputs import ClosureWriter, closure_measures
+from ..table import Reason, Row, Stage
+from .data import CREDIT, TABLE2_AREAS, TABLE3_CENTRE_STRESS
+
+__all__ = ["DESCRIPTION", "reproduce", "EXIT_NO_INPUT"]
+
+DESCRIPTION = "Tables 2–3 (diseased column) of the Texas TriValve 1.0 closed implicitly with leaflet contact"
+EXIT_NO_INPUT = 2
+MPA_TO_KPA = 1e3
+SURFACE = "mid"  # which leaflet surface the areas are measured on (the paper does not say)
+
+
+def _require_input() -> Path:
+    path = trivalve_input()
+    if path is None:
+        print("skvalve reproduce mathur2022: the Texas TriValve 1.0 input (Diseased_QuasiStatic.inp) was not found. "
+              "Set $SKVALVE_TRIVALVE to the .inp file or its folder (model files of " + CREDIT + ", "
+              "not shipped with skvalve).", file=sys.stderr)
+        raise SystemExit(EXIT_NO_INPUT)
+    return path
+
+
+def reproduce(out: Path | None = None, full: bool = False) -> Iterator[Row | Stage]:
+    """Yield the Table 2–3 rows (module docstring); exits with code 2 when the shipped input is absent."""
+    path = _require_input()
+    options = ClosureOptions()
+    yield Stage(f"reading {path.name} and building the implicit model with contact ({CREDIT})")
+    setup = closure_setup(path, options)
+    yield Stage("Table 2 measures of the open (reference) configuration")
+    reference = closure_measures(setup, np.zeros(setup.problem.space.n_dofs), 0.0)
+    yield Row("Table 2 orifice area, diseased (mm²; annulus held)", TABLE2_AREAS["orifice"].diseased,
+              reference.orifice[SURFACE], 0.03, relative=True,
+              note="area enclosed by the annulus projected on its best-fit plane; the annulus nodes are fixed "
+                   "in the input, so open and closed orifices coincide")
+    if not full:
+        yield Row("Table 2 leaflet area, diseased (mm²; open configuration)", TABLE2_AREAS["leaflet"].diseased,
+                  reference.leaflet_area[SURFACE], 0.05, relative=True, expected_difference=Reason.MODEL_DIFFERENCE,
+                  note="mid-surface area of the open, unloaded leaflets: the default run does not close the valve "
+                       "(use --full); the paper's value is at end-systole")
+        return
+    yield Stage("implicit closure: papillary motion 0-0.5, pressure 0.5-1.5 (long: see benchmarks/"
+                "trivalve_closure.py)")
+    callbacks = [] if out is None else [ClosureWriter(Path(out) / "mathur2022_closure.pvd", setup)]
+    run = run_closure(setup, options, callbacks=callbacks, progress=True)
+    if out is not None:
+        write_log(run, Path(out) / "mathur2022_closure_log.txt")
+    reached = run.load_factors[-1] if run.load_factors else 0.0
+    complete = run.error is None and reached >= options.end
+    state = "end-systole" if complete else f"stopped at step time {reached:.3g} of 1.5 ({run.error})"
+    yield Stage(f"closure {state}; undamped residual (norm, relative) {run.undamped_residual}")
+    measures = closure_measures(setup, run.u, reached)
+    reason = None if complete else Reason.MODEL_DIFFERENCE
+    suffix = "" if complete else f"; closure incomplete: {state}"
+    yield Row("Table 2 leaflet area, diseased (mm²)", TABLE2_AREAS["leaflet"].diseased,
+              measures.leaflet_area[SURFACE], 0.1, relative=True, expected_difference=reason,
+              note="mid surface of all leaflets" + suffix if reason else "")
+    yield Row("Table 2 coaptation area, diseased (mm²)", TABLE2_AREAS["coaptation"].diseased,
+              measures.coaptation_area, 0.3, relative=True, expected_difference=Reason.MODEL_DIFFERENCE,
+              note="faces of the contact surface with positive penalty pressure (both sides, as CAREA); "
+                   "frictionless penalty contact, not Abaqus's kinematic contact" + suffix)
+    for name, value in measures.centre_stress.items():
+        leaflet = name.lower()
+        yield Row(f"Table 3 centre max principal Cauchy stress, {leaflet}, diseased (kPa)",
+                  TABLE3_CENTRE_STRESS[leaflet].diseased, value * MPA_TO_KPA, 0.25, relative=True,
+                  expected_difference=Reason.MODEL_DIFFERENCE,
+                  note="mean over the hexes at the leaflet centre region (10 % of the leaflet's mid-surface area, "
+                       "the paper's Fig. 4d region is not given in numbers); quasi-static implicit vs explicit "
+                       "dynamics with mass scaling" + suffix)
+

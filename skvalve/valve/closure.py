@@ -1,0 +1,208 @@
+r"""Implicit, quasi-static closure of a Texas TriValve model: open configuration to end-systole.
+
+The shipped inputs close the valve with Abaqus/Explicit (mass scaling, bulk viscosity). Here the same
+model (:func:`~skvalve.valve.model.valve_model`: F-bar leaflet hexes, collapsed chordae cables, amplitude
+conditions, follower pressure) is solved by Newton's method in load factor = step time, staged as in the
+input: papillary-muscle motion (``Amp-2``, smooth step over 0–0.5) then the transvalvular pressure
+(``Amp-1``, smooth step over 0.5–1.5). Two terms are added:
+
+* :class:`~skvalve.fem.contact.SurfaceContact`: frictionless penalty self-contact of the union of the
+  input's contact surfaces (``LEAFLET_SURFACES_INNER`` and ``LEAFLET_RIM_TIP``; the input uses kinematic
+  contact with friction 0.001, taken as frictionless);
+* :class:`~skvalve.fem.damping.ViscousDamping`: pseudo-transient damping with a coefficient that vanishes at
+  ``damping_off`` (before the end), so the final state is an equilibrium of the undamped problem; the
+  undamped residual there is reported (:attr:`ClosureRun.undamped_residual`).
+
+Every converged step goes to the callbacks (VTU series of :mod:`.outputs`); a failed step raises the
+solver's error with step and load factor, carrying the converged steps (``error.last_converged``).
+"""
+
+from __future__ import annotations
+
+import resource
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..fem.contact import ContactSurface, SurfaceContact
+from ..fem.damping import DampingSchedule, ViscousDamping, undamped_residual
+from ..fem.newton import StepEvent, solve
+from ..fem.problem import Problem
+from ..io.abaqus import HEX_FACE_NODES, AbaqusModel, read_model, trivalve_input
+from .model import ValveModel, valve_model
+
+__all__ = ["ClosureOptions", "ClosureSetup", "ClosureRun", "closure_setup", "contact_surface", "load_factors",
+           "run_closure"]
+
+CONTACT_SURFACES = ("LEAFLET_SURFACES_INNER", "LEAFLET_RIM_TIP")
+
+
+@dataclass
+class ClosureOptions:
+    """Controls of the closure (units of the input: mm, MPa, s).
+
+    penalty : contact penalty (MPa/mm): overlap ~ pressure / (2 penalty) (two-pass).
+    damping : :math:`c_0` of the damping schedule (MPa·s/mm² per unit lumped volume) and ``damping_off``,
+        the step time from which it is zero.
+    papillary_steps, pressure_steps : nominal load steps over 0–0.5 and 0.5–``end``.
+    end : last step time (1.5 = end-systole; less for a partial closure).
+    """
+
+    penalty: float = 1.0
+    damping: float = 1e-4
+    damping_off: float = 1.25
+    papillary_steps: int = 10
+    pressure_steps: int = 20
+    end: float = 1.5
+    max_cutbacks: int = 8
+    max_iter: int = 30
+    rtol: float = 1e-6
+    solver: str | None = None
+
+
+@dataclass
+class ClosureSetup:
+    """The model, its problem and the added contact and damping terms."""
+
+    abaqus: AbaqusModel
+    model: ValveModel
+    problem: Problem
+    contact: SurfaceContact
+    damping: ViscousDamping | None
+    leaflet_of_vertex: np.ndarray
+
+
+@dataclass
+class ClosureRun:
+    """What a closure run did: steps, iterations, contact pairs, times, and the undamped residual at the end."""
+
+    load_factors: list[float] = field(default_factory=list)
+    iterations: list[int] = field(default_factory=list)
+    contact_pairs: list[int] = field(default_factory=list)
+    seconds: float = 0.0
+    peak_memory_mb: float = 0.0
+    undamped_residual: tuple[float, float] | None = None
+    u: np.ndarray | None = None
+    error: str | None = None
+
+
+def load_factors(options: ClosureOptions) -> np.ndarray:
+    """Nominal step times: ``papillary_steps`` over (0, 0.5], ``pressure_steps`` over (0.5, end]."""
+    first = np.linspace(0.0, min(0.5, options.end), options.papillary_steps + 1)[1:]
+    if options.end <= 0.5:
+        return first
+    return np.concatenate([first, np.linspace(0.5, options.end, options.pressure_steps + 1)[1:]])
+
+
+def _brick_connectivity(abaqus: AbaqusModel) -> tuple[dict[int, np.ndarray], dict[int, int]]:
+    """Global element index -> its 8 global node indices (bricks only), and -> its label (all elements)."""
+    conn, labels = {}, {}
+    for block in abaqus.element_blocks:
+        for index, label, row in zip(block.indices, block.labels, block.connectivity, strict=True):
+            labels[int(index)] = int(label)
+            if block.connectivity.shape[1] == 8:
+                conn[int(index)] = row
+    return conn, labels
+
+
+def contact_surface(abaqus: AbaqusModel, model: ValveModel, names=CONTACT_SURFACES) -> ContactSurface:
+    """The union of the named element-face surfaces as a :class:`ContactSurface` on the model's vertices.
+
+    Brick (C3D8/C3D8R) faces S1–S6 only; faces are oriented away from their element.
+    """
+    conn, labels = _brick_connectivity(abaqus)
+    vertex_of = np.full(abaqus.nodes.shape[0], -1, dtype=np.int64)
+    has_source = model.vertex_source >= 0
+    vertex_of[model.vertex_source[has_source]] = np.flatnonzero(has_source)
+    quads, inside = [], []
+    for name in names:
+        surface = abaqus.surface(name)
+        for group in surface.faces:
+            face = group.face.upper()
+            if face not in HEX_FACE_NODES:
+                raise ValueError(f"contact surface {name!r}: face {face} is not a brick face S1..S6 (shell models "
+                                 "are extruded by the model builder; their contact surfaces are not mapped yet)")
+            for element in group.elements:
+                row = conn.get(int(element))
+                if row is None:
+                    raise ValueError(f"contact surface {name!r}: element {labels.get(int(element), int(element))} "
+                                     "is not a brick")
+                vertices = vertex_of[row]
+                if np.any(vertices < 0):
+                    raise ValueError(f"contact surface {name!r}: element {labels.get(int(element), int(element))} "
+                                     "has nodes outside the model's mesh")
+                quads.append(vertices[list(HEX_FACE_NODES[face])])
+                inside.append(model.mesh.p[:, vertices].mean(axis=1))
+    quads_arr = np.array(quads, dtype=np.int64)
+    _, first = np.unique(np.sort(quads_arr, axis=1), axis=0, return_index=True)
+    first = np.sort(first)
+    return ContactSurface.from_quads(model.mesh.p.T, quads_arr[first], np.array(inside)[first])
+
+
+def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: AbaqusModel | None = None
+                  ) -> ClosureSetup:
+    """Read the input (``path``; default the shipped diseased 1.0 valve) and build problem, contact, damping."""
+    options = options or ClosureOptions()
+    if abaqus is None:
+        path = trivalve_input() if path is None else path
+        if path is None:
+            raise FileNotFoundError("Texas TriValve input not found: set $SKVALVE_TRIVALVE to the .inp file or its "
+                                    "folder (model files of Mathur et al. 2022, CC BY-NC-SA 4.0)")
+        abaqus = read_model(path)
+    model = valve_model(abaqus)
+    problem = model.problem()
+    surface = contact_surface(abaqus, model)
+    contact = problem.add_term(SurfaceContact(problem.space, surface, options.penalty))
+    damping = None
+    if options.damping > 0.0:
+        damping = problem.add_term(ViscousDamping(problem.space, DampingSchedule(options.damping,
+                                                                                   options.damping_off)))
+    leaflet = np.full(model.mesh.p.shape[1], -1, dtype=np.int64)
+    leaflet[model.mesh.t] = model.regions[None, :]
+    return ClosureSetup(abaqus, model, problem, contact, damping, leaflet)
+
+
+def run_closure(setup: ClosureSetup, options: ClosureOptions | None = None, callbacks=(), progress: bool = True,
+                verbose: bool = False) -> ClosureRun:
+    """Solve the staged closure; never raises for a failed step: the run records the error and the last state.
+
+    The returned :class:`ClosureRun` has the converged step times, Newton iterations and active contact pairs
+    per step, wall time, peak resident memory of the process, and the undamped residual at the last converged state.
+    """
+    options = options or ClosureOptions()
+    run = ClosureRun()
+
+    def record(event: StepEvent) -> None:
+        run.load_factors.append(float(event.load_factor))
+        run.iterations.append(len(event.result.histories[-1]))
+        run.contact_pairs.append(setup.contact.last_pairs.size if setup.contact.last_pairs is not None else 0)
+        run.u = event.u
+
+    start = time.perf_counter()
+    try:
+        solve(setup.problem, load_factors(options), rtol=options.rtol, max_iter=options.max_iter,
+              max_cutbacks=options.max_cutbacks, solver=options.solver, progress=progress, verbose=verbose,
+              callbacks=[record, *callbacks])
+    except Exception as err:  # noqa: BLE001 - a failed closure is a result to report, with its last state
+        run.error = f"{type(err).__name__}: {err}"
+    finally:
+        run.peak_memory_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: kB
+        run.seconds = time.perf_counter() - start
+    if run.u is not None:
+        run.undamped_residual = undamped_residual(setup.problem, run.u, run.load_factors[-1])
+    return run
+
+
+def write_log(run: ClosureRun, path: Path) -> None:
+    """A plain-text summary of the run (atomic write)."""
+    lines = [f"seconds {run.seconds:.1f}", f"peak_memory_mb {run.peak_memory_mb:.0f}",
+             f"steps {len(run.load_factors) - 1}", f"newton_iterations {sum(run.iterations)}",
+             f"last_load_factor {run.load_factors[-1] if run.load_factors else float('nan'):.6g}",
+             f"undamped_residual {run.undamped_residual}", f"error {run.error}"]
+    lines += [f"step {k} t={t:.5g} iterations={i} contact_pairs={c}"
+              for k, (t, i, c) in enumerate(zip(run.load_factors, run.iterations, run.contact_pairs, strict=True))]
+    temporary = path.with_name(f".{path.name}.tmp")
+    temporary.write_text("\n".join(lines) + "\n")
+    temporary.replace(path)

@@ -1,0 +1,89 @@
+"""The closure driver (skvalve.valve.closure) on a small contact problem, and its contact surface and staging on
+the shipped diseased Texas TriValve input (skipped when the input is absent)."""
+
+import numpy as np
+import pytest
+import skfem
+
+from skvalve.fem import Problem, Space
+from skvalve.fem.constitutive import MaterialRegions
+from skvalve.fem.contact import ContactSurface, SurfaceContact
+from skvalve.fem.damping import DampingSchedule, ViscousDamping
+from skvalve.fem.hyperelastic import HyperelasticTerm
+from skvalve.io.abaqus import read_model, trivalve_input
+from skvalve.materials import NeoHookean
+from skvalve.valve.closure import ClosureOptions, ClosureSetup, contact_surface, load_factors, run_closure
+from skvalve.valve.model import valve_model
+
+
+def _blocks_setup(shortening: float) -> ClosureSetup:
+    """Two unit cubes (2x2x2 hexes each) on rollers, the top face pushed down by ``shortening`` x t/end."""
+    bottom = skfem.MeshHex.init_tensor(*(np.linspace(0, 1, 3),) * 3)
+    top = skfem.MeshHex.init_tensor(*(np.linspace(0, 1, 3),) * 2, np.linspace(1, 2, 3))
+    mesh = skfem.MeshHex(np.hstack([bottom.p, top.p]), np.hstack([bottom.t, top.t + bottom.p.shape[1]]))
+    space = Space(mesh)
+    problem = Problem(space, [HyperelasticTerm(space, MaterialRegions(mesh, NeoHookean(1.0, 2.0)))])
+    surface = ContactSurface.from_facets(mesh, mesh.facets_satisfying(lambda X: np.abs(X[2] - 1) < 1e-9, True))
+    contact = problem.add_term(SurfaceContact(space, surface, 50.0, smoothing=0.01))
+    damping = problem.add_term(ViscousDamping(space, DampingSchedule(0.5, t_off=1.0)))
+    for axis in range(3):
+        problem.add_dirichlet(lambda X, a=axis: X[a] == 0.0, 0.0, components=[axis])
+    problem.add_dirichlet(lambda X: X[2] == 2.0, lambda X, t: -shortening * t / 1.5 * np.ones_like(X), components=[2])
+    return ClosureSetup(None, None, problem, contact, damping, np.zeros(mesh.p.shape[1], dtype=int))
+
+
+def test_load_factors_follow_the_two_stages():
+    factors = load_factors(ClosureOptions(papillary_steps=5, pressure_steps=4))
+    np.testing.assert_allclose(factors, [0.1, 0.2, 0.3, 0.4, 0.5, 0.75, 1.0, 1.25, 1.5])
+    np.testing.assert_allclose(load_factors(ClosureOptions(papillary_steps=2, end=0.25)), [0.125, 0.25])
+
+
+def test_closure_driver_reaches_the_end_with_damping_off_and_records_the_run():
+    setup = _blocks_setup(0.15)
+    options = ClosureOptions(papillary_steps=2, pressure_steps=2, rtol=1e-7, solver="scipy")
+    run = run_closure(setup, options, progress=False)
+    assert run.error is None
+    assert run.load_factors == pytest.approx([0.0, 0.25, 0.5, 1.0, 1.5])
+    assert run.contact_pairs[-1] == 18  # 9 nodes of each face, two passes
+    assert sum(run.iterations) > 0 and run.seconds > 0 and run.peak_memory_mb > 0
+    assert run.undamped_residual[1] < 1e-6  # the damping is off at t >= 1: the end state is undamped equilibrium
+
+
+def test_a_failed_closure_reports_where_it_stopped_and_keeps_the_last_state():
+    setup = _blocks_setup(1.9)  # would push the top block through the bottom one and invert elements
+    options = ClosureOptions(papillary_steps=2, pressure_steps=2, max_cutbacks=1, max_iter=6, solver="scipy")
+    run = run_closure(setup, options, progress=False)
+    assert run.error is not None and "load factor" in run.error
+    assert run.u is not None and np.all(np.isfinite(run.u))
+    assert run.load_factors[-1] < 1.5
+
+
+DISEASED = trivalve_input()
+
+
+@pytest.mark.skipif(DISEASED is None, reason="Texas TriValve input not found (../shared/data)")
+def test_contact_surface_of_the_shipped_valve_lies_on_the_boundary_and_faces_outward():
+    abaqus = read_model(DISEASED)
+    model = valve_model(abaqus)
+    surface = contact_surface(abaqus, model)
+    n_faces = sum(len(group.elements) for name in ("LEAFLET_SURFACES_INNER", "LEAFLET_RIM_TIP")
+                  for group in abaqus.surface(name).faces)
+    assert n_faces >= surface.quads.shape[0] > 0.9 * n_faces  # duplicates between the two surfaces dropped
+    mesh = model.mesh
+    boundary = {tuple(sorted(f)) for f in mesh.facets[:, mesh.boundary_facets()].T.tolist()}
+    assert all(tuple(sorted(q)) in boundary for q in surface.quads.tolist())
+    # outward: the face normal points away from the centroid of the hex that owns the face
+    X, cells = mesh.p.T, mesh.t.T
+    cells_of: dict[int, set] = {}
+    for e, cell in enumerate(cells.tolist()):
+        for v in cell:
+            cells_of.setdefault(v, set()).add(e)
+    Q = X[surface.quads]
+    normal = np.cross(Q[:, 2] - Q[:, 0], Q[:, 3] - Q[:, 1])
+    for q, n in zip(surface.quads.tolist(), normal, strict=True):
+        (owner,) = set.intersection(*(cells_of[v] for v in q))
+        assert np.dot(n, X[q].mean(axis=0) - X[cells[owner]].mean(axis=0)) > 0
+    # the staging of the closure matches the input's amplitudes: papillary Amp-2 ends at 0.5, pressure Amp-1 at 1.5
+    assert abaqus.amplitude("Amp-2").times[-1] == pytest.approx(0.5)
+    assert abaqus.amplitude("Amp-1").times[-1] == pytest.approx(1.5)
+    assert load_factors(ClosureOptions())[-1] == pytest.approx(abaqus.steps[0].time_period)
