@@ -15,6 +15,7 @@ from skvalve.networks.dense_cholesky import (
     factor_with_shift,
     interior_numbering,
     node_cholesky_in_place,
+    node_cholesky_solve,
 )
 from skvalve.networks.generate import generate
 from skvalve.networks.network import Network
@@ -278,9 +279,10 @@ def test_node_blocked_cholesky_matches_numpy():
     work = np.full((36, 36), np.nan)
     assert factor_with_shift(np.tril(matrix), work, 36, first, True)
     rhs = rng.normal(size=(36, 9))
-    y = rhs.copy()
-    cholesky_solve(work, 36, first, y)
-    np.testing.assert_allclose(y, np.linalg.solve(matrix, rhs), rtol=1e-10, atol=1e-12)
+    for solve in (cholesky_solve, node_cholesky_solve):
+        y = rhs.copy()
+        solve(work, 36, first, y)
+        np.testing.assert_allclose(y, np.linalg.solve(matrix, rhs), rtol=1e-10, atol=1e-12)
     indefinite = matrix - (np.linalg.eigvalsh(matrix)[0] + 1.0) * np.eye(36)
     assert not node_cholesky_in_place(np.tril(indefinite), 36, first)
 

@@ -108,6 +108,36 @@ def cholesky_solve(factor: np.ndarray, n: int, first: np.ndarray, b: np.ndarray)
 
 
 @njit(cache=True, fastmath=FAST)
+def node_cholesky_solve(factor: np.ndarray, n: int, first: np.ndarray, b: np.ndarray) -> None:
+    """:func:`cholesky_solve` for a node-structured envelope (see :func:`node_cholesky_in_place`):
+    the three rows of a node are updated together, sharing the loads of the right-hand sides."""
+    r = b.shape[1]
+    for I in range(0, n, 3):
+        for k in range(first[I], I):
+            c0, c1, c2 = factor[I, k], factor[I + 1, k], factor[I + 2, k]
+            for j in range(r):
+                bk = b[k, j]
+                b[I, j] -= c0 * bk
+                b[I + 1, j] -= c1 * bk
+                b[I + 2, j] -= c2 * bk
+        for j in range(r):  # the node's diagonal block, forward
+            y0 = b[I, j] / factor[I, I]
+            y1 = (b[I + 1, j] - factor[I + 1, I] * y0) / factor[I + 1, I + 1]
+            y2 = (b[I + 2, j] - factor[I + 2, I] * y0 - factor[I + 2, I + 1] * y1) / factor[I + 2, I + 2]
+            b[I, j], b[I + 1, j], b[I + 2, j] = y0, y1, y2
+    for I in range(n - 3, -1, -3):
+        for j in range(r):  # the node's diagonal block, backward (Lᵀ)
+            x2 = b[I + 2, j] / factor[I + 2, I + 2]
+            x1 = (b[I + 1, j] - factor[I + 2, I + 1] * x2) / factor[I + 1, I + 1]
+            x0 = (b[I, j] - factor[I + 1, I] * x1 - factor[I + 2, I] * x2) / factor[I, I]
+            b[I, j], b[I + 1, j], b[I + 2, j] = x0, x1, x2
+        for i in range(first[I], I):
+            c0, c1, c2 = factor[I, i], factor[I + 1, i], factor[I + 2, i]
+            for j in range(r):
+                b[i, j] -= c0 * b[I, j] + c1 * b[I + 1, j] + c2 * b[I + 2, j]
+
+
+@njit(cache=True, fastmath=FAST)
 def cholesky_solve_vector(factor: np.ndarray, n: int, first: np.ndarray, b: np.ndarray) -> None:
     """Solve L Lᵀ y = b in place for one right-hand side b (n,).
 

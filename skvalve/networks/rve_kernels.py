@@ -23,7 +23,7 @@ import numpy as np
 from numba import njit, prange
 
 from skvalve.materials.exponential_fiber import normalized_energy, normalized_force_stiffness
-from skvalve.networks.dense_cholesky import cholesky_solve, cholesky_solve_vector, factor_with_shift
+from skvalve.networks.dense_cholesky import cholesky_solve_vector, factor_with_shift, node_cholesky_solve
 from skvalve.networks.rve_tangent import FIBER_DATA_COLUMNS, stress_and_tangent
 
 # status codes of ``solve_network``
@@ -232,7 +232,7 @@ def _sensitivities(X, x, fibers, dof, first, n_free, factor, fiber_data, sensiti
                 kip = (axial - lateral) * e[i] * e[p] + (lateral if i == p else 0.0)
                 for q in range(3):
                     sensitivity[3 * row + i, 3 * p + q] += kip * X[node, q]
-    cholesky_solve(factor, 3 * n_free, first, sensitivity)
+    node_cholesky_solve(factor, 3 * n_free, first, sensitivity)
 
 
 @njit(cache=True)
