@@ -117,7 +117,7 @@ def reproduce(out: Path | None = None, full: bool = False) -> Iterator[Row | Sta
 
 def fit_and_sensitivity_rows(sample: Sample, full: bool = False) -> Iterator[Row | Stage]:
     """Fit check (known parameters recovered, Eq. 12 R² = 1) and the ±5 % sensitivity against §4."""
-    setting = fast_setting(sample, max_networks=8 if full else 3)
+    setting = fast_setting(sample, max_networks=8 if full else 2)
     yield Stage(f"fast path: homogeneous model on {len(setting.networks)} networks, fit check and ±5 % sensitivity")
     curves = model_curves(setting, levels=6 if full else 4)
     result = fit_check(setting, curves)
