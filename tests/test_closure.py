@@ -12,6 +12,7 @@ from skvalve.fem.damping import DampingSchedule, ViscousDamping
 from skvalve.fem.hyperelastic import HyperelasticTerm
 from skvalve.io.abaqus import read_model, trivalve_input
 from skvalve.materials import NeoHookean
+from skvalve.papers.mathur2022 import reproduce as reproduce_module
 from skvalve.valve.closure import ClosureOptions, ClosureSetup, contact_surface, load_factors, run_closure
 from skvalve.valve.model import valve_model
 
@@ -87,3 +88,12 @@ def test_contact_surface_of_the_shipped_valve_lies_on_the_boundary_and_faces_out
     assert abaqus.amplitude("Amp-2").times[-1] == pytest.approx(0.5)
     assert abaqus.amplitude("Amp-1").times[-1] == pytest.approx(1.5)
     assert load_factors(ClosureOptions())[-1] == pytest.approx(abaqus.steps[0].time_period)
+
+
+def test_reproduce_without_the_shipped_input_exits_with_a_message(monkeypatch, capsys):
+    module = reproduce_module
+    monkeypatch.setattr(module, "trivalve_input", lambda: None)
+    with pytest.raises(SystemExit) as exit_info:
+        next(module.reproduce(None))
+    assert exit_info.value.code == module.EXIT_NO_INPUT == 2
+    assert "SKVALVE_TRIVALVE" in capsys.readouterr().err
