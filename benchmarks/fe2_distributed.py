@@ -56,7 +56,8 @@ def dispatch_latency(sample, client, repeats: int = 20) -> tuple[float, float]:
     reference = fe2_material(sample)
     settings = dict(n_points=1, psi=reference.psi, fiber_diameter=reference.fiber_diameter)
     local = RVEMaterial(sample.networks[:2], reference.matrix, reference.fiber, **settings)
-    remote = DistributedRVEMaterial(sample.networks[:2], reference.matrix, reference.fiber, client, **settings)
+    remote = DistributedRVEMaterial(sample.networks[:2], reference.matrix, reference.fiber, client, numba_threads=1,
+                                    **settings)
     F = [np.broadcast_to(np.diag([1.0 + 1e-3 * k, 1.0, 1.0])[:, :, None, None], (3, 3, 1, 2)).copy() for k in (1, 2)]
     seconds = []
     for material in (local, remote):
@@ -84,10 +85,10 @@ def main() -> None:
           f"{run_local.iterations} macro iterations, {calls_local} RVE batch evaluations of {local.n_rves} RVEs, "
           f"RVE time {local.solve_seconds:.1f} s")
 
-    with LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                      env={"NUMBA_NUM_THREADS": "1"}) as cluster, Client(cluster) as client:
+    cluster_options = dict(n_workers=args.workers, threads_per_worker=1, processes=True, dashboard_address=":0")
+    with LocalCluster(**cluster_options) as cluster, Client(cluster) as client:
         start = time.perf_counter()
-        remote = DistributedRVEMaterial.from_material(fe2_material(sample), client)
+        remote = DistributedRVEMaterial.from_material(fe2_material(sample), client, numba_threads=1)
         client.run(numba.get_num_threads)  # workers started and imported
         setup = time.perf_counter() - start
         run_remote, wall_remote, calls_remote = timed_protocol(sample, remote)

@@ -23,15 +23,15 @@ No actors are used: a future's data stays on its worker until the client release
 Running on a cluster (see ``docs/thomas2019_distributed.md``)::
 
     from distributed import Client, LocalCluster
-    client = Client(LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                 env={"NUMBA_NUM_THREADS": "1"}))
-    material = DistributedRVEMaterial.from_material(fe2_material(sample), client)
+    client = Client(LocalCluster(n_workers=2, threads_per_worker=1, processes=True))
+    material = DistributedRVEMaterial.from_material(fe2_material(sample), client, numba_threads=1)
     run_protocol(sample, material, (1.0, 1.0))
 
 With dask-jobqueue (SLURM) use ``SLURMCluster(cores=..., processes=1, memory=...)`` and
 ``cluster.scale(jobs=n)``; with dask-mpi call ``dask_mpi.initialize()`` and ``Client()`` in a script started
-by ``mpirun``. One worker process per node with all of its cores as numba threads (``NUMBA_NUM_THREADS``,
-``threads_per_worker=1``) is the efficient layout: the chunk's solve is already multithreaded.
+by ``mpirun``. One worker process per node with all of its cores as numba threads (``threads_per_worker=1``,
+numba's default thread count) is the efficient layout: the chunk's solve is already multithreaded. Workers
+sharing a machine split its cores with ``numba_threads``.
 
 If a worker is lost its RVE states are lost with it; :meth:`state` (e.g. the checkpoint of every converged
 load step) and :meth:`set_state` restart the run. Post-processing that needs the packed arrays of an
@@ -47,6 +47,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+import numba
 import numpy as np
 
 from ..materials.exponential_fiber import ExponentialFiber
@@ -93,6 +94,7 @@ class _ChunkInput:
     max_iter: int
     first_rve: int  # global index of the chunk's first RVE (for error messages)
     n_points: int
+    numba_threads: int | None  # numba threads of the worker's solves (None: numba's default)
 
 
 # ---------------------------------------------------------------------- worker-side functions
@@ -104,6 +106,8 @@ def _build_batch(spec: _ChunkInput) -> tuple[RVEBatch, _ChunkInput]:
 def _solve_chunk(built: tuple[RVEBatch, _ChunkInput], committed: ChunkTrial | None, F: np.ndarray) -> ChunkTrial:
     """Solve the chunk's RVEs at F from ``committed.state`` (None: cold, the reference solve); inputs not mutated."""
     resident, spec = built
+    if spec.numba_threads is not None:  # per calling thread in numba: set in the task itself
+        numba.set_num_threads(min(spec.numba_threads, numba.config.NUMBA_NUM_THREADS))
     batch = copy.copy(resident)  # shallow: the state arrays are rebound below, never written in place
     if committed is not None:
         state = committed.state
@@ -116,10 +120,11 @@ def _solve_chunk(built: tuple[RVEBatch, _ChunkInput], committed: ChunkTrial | No
         out = batch.solve(F, update_state=False)
     except RuntimeError as err:
         text = str(err)
-        if text.startswith("RVE "):
-            r = spec.first_rve + int(text.split()[1].rstrip(":"))
-            text = f"RVE of element {r // spec.n_points}, quadrature point {r % spec.n_points}: {text}"
-        raise RVEFailure(f"DistributedRVEMaterial: {text}") from err
+        if not text.startswith("RVE "):  # not a force-balance failure (e.g. numba): no cut-back can help
+            raise
+        r = spec.first_rve + int(text.split()[1].rstrip(":"))
+        where = f"RVE of element {r // spec.n_points}, quadrature point {r % spec.n_points}"
+        raise RVEFailure(f"DistributedRVEMaterial: {where}: {text}") from err
     state = ChunkState(out["x"], np.array(F, copy=True), out["sensitivity"], out["stretch"])
     return ChunkTrial(state, out["cauchy"], out["tangent"], time.perf_counter() - start)
 
@@ -150,15 +155,25 @@ class DistributedRVEMaterial(RVEMaterial):
 
     Parameters
     ----------
-    networks, matrix, fiber, n_points, psi, fiber_diameter, tol, max_iter : as :class:`RVEMaterial`
-        (the fiber volume fraction ψ and the fiber diameter have no defaults here: pass the model's values).
-    client : a connected ``distributed.Client`` (LocalCluster, dask-jobqueue, dask-mpi, ...).
-    chunks : number of contiguous element ranges (tasks per evaluation); default one per worker.
-    state : a committed :class:`RVEMaterialState` to start from (default: the reference state F = I,
-        solved on the workers).
+    networks, matrix, fiber, n_points, psi, fiber_diameter, tol, max_iter
+        As :class:`RVEMaterial`; the fiber volume fraction ψ and the fiber diameter have no defaults here
+        (pass the model's values).
+    client : distributed.Client
+        A connected client (LocalCluster, dask-jobqueue, dask-mpi, ...).
+    chunks : int, optional
+        Number of contiguous element ranges (tasks per evaluation); default one per worker.
+    numba_threads : int, optional
+        Numba threads of each chunk's solve on its worker (at most the worker's ``NUMBA_NUM_THREADS``);
+        default numba's (all cores of the worker's machine).
+    state : RVEMaterialState, optional
+        A committed state to start from; default the reference state F = I, solved on the workers.
 
+    Notes
+    -----
     Same interface as :class:`RVEMaterial`: ``pk1``, ``pk1_and_tangent``, ``cauchy``, ``fiber_cauchy``,
     ``commit``, ``rewind``, ``state``, ``set_state``, ``committed_nodes``, ``committed_fiber_stretch``.
+    ``worker_seconds`` sums, over the evaluations, the slowest chunk's solve time on its worker
+    (``solve_seconds`` minus it is the Dask overhead).
     """
 
     def __init__(
@@ -174,6 +189,7 @@ class DistributedRVEMaterial(RVEMaterial):
         tol: float = 1e-10,
         max_iter: int = 30,
         chunks: int | None = None,
+        numba_threads: int | None = None,
         state: RVEMaterialState | None = None,
     ) -> None:
         # RVEMaterial.__init__ is not called: it would build and solve every RVE in this process
@@ -195,6 +211,9 @@ class DistributedRVEMaterial(RVEMaterial):
         if isinstance(n_chunks, bool) or int(n_chunks) != n_chunks or not 1 <= n_chunks <= len(networks):
             raise ValueError(f"DistributedRVEMaterial: chunks must be an integer in 1..{len(networks)} "
                              f"(number of elements), got {chunks!r}")
+        if numba_threads is not None and (isinstance(numba_threads, bool) or int(numba_threads) != numba_threads
+                                          or numba_threads < 1):
+            raise ValueError(f"DistributedRVEMaterial: numba_threads must be a positive integer, got {numba_threads!r}")
         self.matrix, self.fiber = matrix, fiber
         self.psi, self.fiber_diameter, self.tol, self.max_iter = psi, fiber_diameter, tol, int(max_iter)
         self.n_elements, self.n_points = len(networks), int(n_points)
@@ -211,7 +230,7 @@ class DistributedRVEMaterial(RVEMaterial):
         for c, (e0, e1) in enumerate(zip(element_bounds[:-1], element_bounds[1:], strict=True)):
             per_point = [net for net in networks[e0:e1] for _ in range(self.n_points)]
             spec = _ChunkInput(per_point, fiber, psi, fiber_diameter, tol, self.max_iter, int(self.rve_bounds[c]),
-                               self.n_points)
+                               self.n_points, numba_threads)
             [spec_future] = client.scatter([spec], workers=[self.owners[c]], broadcast=False)
             self._batches.append(self._submit(c, _build_batch, spec_future))
         self._committed: list[Future] = []
@@ -226,13 +245,15 @@ class DistributedRVEMaterial(RVEMaterial):
             self.set_state(state)
 
     @classmethod
-    def from_material(cls, material: RVEMaterial, client: Client, chunks: int | None = None) -> DistributedRVEMaterial:
+    def from_material(cls, material: RVEMaterial, client: Client, chunks: int | None = None,
+                      numba_threads: int | None = None) -> DistributedRVEMaterial:
         """The same model as ``material`` (settings and committed state), evaluated on ``client``'s workers."""
         if isinstance(material, DistributedRVEMaterial):
             raise TypeError("DistributedRVEMaterial.from_material: the material is already distributed")
         return cls(material.networks, material.matrix, material.fiber, client, n_points=material.n_points,
                    psi=material.psi, fiber_diameter=material.fiber_diameter, tol=material.tol,
-                   max_iter=material.batch.max_iter, chunks=chunks, state=material.state())
+                   max_iter=material.batch.max_iter, chunks=chunks, numba_threads=numba_threads,
+                   state=material.state())
 
     @property
     def batch(self) -> RVEBatch:
