@@ -399,7 +399,7 @@ print(f"threshold muS for |S| = {b14.LAMBDA_EXPERIMENT_ERROR}: {1000 * threshold
 #   1 kPa at Δκ = 0.2, so **the paper's "< 1 kPa" is reproduced**.
 # * S grows in proportion to Δκ in the full sweep (the paper: "greater bending simply created greater sliding"), and
 #   at 10 kPa (22 % of the outer modulus) |S| stays far below both limits, so "**bonded when μS ≥ 25 %**" holds; the
-#   numbers are in the reproduction table ([docs/buchanan2014.md](../docs/buchanan2014.md)).
+#   numbers are in the reproduction table (`skvalve reproduce buchanan2014 --full`, `docs/buchanan2014.md`).
 
 # %%
 assert abs(q["M_Py"] / q["M_reaction"] - 1) < 1e-4 and abs(q["M_stress"] / q["M_Py"] - 1) < 0.01
