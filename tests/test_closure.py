@@ -1,6 +1,9 @@
 """The closure driver (skvalve.valve.closure) on a small contact problem, and its contact surface and staging on
 the shipped diseased Texas TriValve input (skipped when the input is absent)."""
 
+from types import SimpleNamespace
+
+import meshio
 import numpy as np
 import pytest
 import skfem
@@ -15,6 +18,7 @@ from skvalve.materials import NeoHookean
 from skvalve.papers.mathur2022 import reproduce as reproduce_module
 from skvalve.valve.closure import ClosureOptions, ClosureSetup, contact_surface, load_factors, run_closure
 from skvalve.valve.model import valve_model
+from skvalve.valve.outputs import ClosureWriter
 
 
 def _blocks_setup(shortening: float) -> ClosureSetup:
@@ -97,3 +101,27 @@ def test_reproduce_without_the_shipped_input_exits_with_a_message(monkeypatch, c
         next(module.reproduce(None))
     assert exit_info.value.code == module.EXIT_NO_INPUT == 2
     assert "SKVALVE_TRIVALVE" in capsys.readouterr().err
+
+
+def test_closure_writer_writes_contact_pressure_and_stress_per_step(tmp_path):
+    setup = _blocks_setup(0.15)
+    mesh = setup.problem.mesh
+    setup.model = SimpleNamespace(mesh=mesh, chordae=SimpleNamespace(ends=np.array([[0, 26]])),
+                                  regions=np.zeros(mesh.nelements, dtype=int))
+    writer = ClosureWriter(tmp_path / "closure.pvd", setup)
+    options = ClosureOptions(papillary_steps=1, pressure_steps=1, rtol=1e-7, solver="scipy")
+    run = run_closure(setup, options, callbacks=[writer], progress=False)
+    assert run.error is None
+    files = sorted(tmp_path.glob("closure_*.vtu"))
+    assert len(files) == len(run.load_factors) == 3
+    assert (tmp_path / "closure.pvd").read_text().count("<DataSet") == 3
+    last = meshio.read(files[-1])
+    np.testing.assert_allclose(last.point_data["displacement"].ravel(), run.u)
+    pressure = last.point_data["contact_pressure"]
+    assert pressure.max() > 0 and np.all(pressure[setup.contact.surface.nodes] > 0)
+    # hexes are written in VTK order: every cell has a positive volume in the reference configuration
+    hexes = last.cells_dict["hexahedron"]
+    P = last.points[hexes]
+    jac = np.einsum("ij,ij->i", np.cross(P[:, 1] - P[:, 0], P[:, 3] - P[:, 0]), P[:, 4] - P[:, 0])
+    assert np.all(jac > 0)
+    assert last.cell_data_dict["max_principal_cauchy"]["hexahedron"].shape == (mesh.nelements,)
