@@ -49,6 +49,15 @@ def main() -> int:
     options = ClosureOptions(end=args.end)
     setup = closure_setup(options=options)
     print("model:", setup.model.counts(), "contact faces:", setup.contact.surface.quads.shape[0], flush=True)
+    if args.verbose:
+        search = setup.contact.active_pairs
+
+        def logged_search(u):
+            pairs = search(u)
+            logging.info("contact pairs %d", pairs.size)
+            return pairs
+
+        setup.contact.active_pairs = logged_search
     run = run_closure(setup, options, callbacks=[LastState(args.out)], progress=False, verbose=args.verbose)
     write_log(run, args.out / "closure_log.txt")
     print(f"wall time {run.seconds:.1f} s, load steps {len(run.load_factors) - 1}, "
