@@ -15,11 +15,11 @@ TRUE = FiberParameters(G=2.1e3, E_f=10.5e3, beta=50.5, lambda_c=1.12)
 
 @pytest.fixture(scope="module")
 def setting():
-    nets = [generate(35.0, 0.0, n_fibers=60, seed=1)]
+    nets = [generate(35.0, 0.0, n_fibers=60, seed=s) for s in range(2)]
     return Setting(nets, nu=0.49, psi=0.43, diameter=450e-9, thickness=0.406e-3)
 
 
-def synthetic(setting, ratio, levels=4, max_tension=40.0):
+def synthetic(setting, ratio, levels=5, max_tension=40.0):
     """Tension-controlled path of the model itself (a different solve from the fit's stretch-controlled one)."""
     matrix = NeoHookean.from_shear_poisson(TRUE.G, setting.nu)
     fiber = ExponentialFiber.from_diameter(TRUE.E_f, setting.diameter, TRUE.beta, TRUE.lambda_c)
