@@ -5,10 +5,12 @@ the chordae, pressure facets and conditions. Skips when the data (../shared/data
 import numpy as np
 import pytest
 
+from skvalve.fem import FollowerPressure
 from skvalve.fem.truss import LawAssignment
-from skvalve.io.abaqus import read_model, trivalve_inputs
+from skvalve.io.abaqus import HEX_FACE_NODES, read_model, trivalve_inputs
 from skvalve.materials.uniaxial import TensionOnly
 from skvalve.valve.chordae import collapse_chains, tangent_on_free_nodes
+from skvalve.valve.extrude import hex_corner_jacobians
 from skvalve.valve.model import valve_model
 
 INPUTS = trivalve_inputs()
@@ -54,7 +56,6 @@ def test_shipped_input_becomes_a_model(models, key):
     ends = model.chordae.ends
     assert np.allclose(X[ends], abaqus.nodes[red.ends], atol=1e-12)
     # positively oriented hexes (scikit-fem checks its own Jacobians)
-    from skvalve.valve.extrude import hex_corner_jacobians
     abaqus_order = model.mesh.t.T[:, np.argsort([0, 4, 3, 1, 7, 5, 2, 6])]
     assert np.all(hex_corner_jacobians(X, abaqus_order) > 0)
 
@@ -112,9 +113,6 @@ def test_diseased_pressure_and_conditions_follow_the_input(models):
     tips are at -14 mm x SMOOTH STEP(0, 0.5)."""
     if "1.0-diseased" not in models:
         pytest.skip("1.0 diseased not present")
-    from skvalve.fem import FollowerPressure
-    from skvalve.io.abaqus import HEX_FACE_NODES
-
     abaqus, model = models["1.0-diseased"]
     problem = model.problem()
     pressure = next(term for term in problem.terms if isinstance(term, FollowerPressure))
