@@ -87,9 +87,10 @@ def main() -> None:
 
     cluster_options = dict(n_workers=args.workers, threads_per_worker=1, processes=True, dashboard_address=":0")
     with LocalCluster(**cluster_options) as cluster, Client(cluster) as client:
+        # first: the latency check, which also loads the compiled kernels on the workers (as fe2_material did here)
+        latency_local, latency_remote = dispatch_latency(sample, client)
         start = time.perf_counter()
         remote = DistributedRVEMaterial.from_material(fe2_material(sample), client, numba_threads=1)
-        client.run(numba.get_num_threads)  # workers started and imported
         setup = time.perf_counter() - start
         run_remote, wall_remote, calls_remote = timed_protocol(sample, remote)
         print(f"LocalCluster ({args.workers} workers x 1 numba thread, chunks of "
@@ -98,7 +99,6 @@ def main() -> None:
               f"RVE time {remote.solve_seconds:.1f} s")
         difference = np.abs(run_remote.u - run_local.u).max() / np.abs(run_local.u).max()
         print(f"final displacement, max relative difference distributed vs in-process: {difference:.1e}")
-        latency_local, latency_remote = dispatch_latency(sample, client)
         print(f"one evaluation of 2 RVEs (dispatch cost): in-process {latency_local * 1e3:.1f} ms, "
               f"distributed {latency_remote * 1e3:.1f} ms")
 
