@@ -40,13 +40,20 @@ def main() -> int:
     parser.add_argument("--out", type=Path, default=Path("trivalve_closure_out"))
     parser.add_argument("--end", type=float, default=1.5, help="last step time (1.5 = end-systole)")
     parser.add_argument("--verbose", action="store_true", help="one line per Newton iteration")
+    parser.add_argument("--resume", action="store_true", help="start from --out/last_state.npz")
+    parser.add_argument("--damping", type=float, default=ClosureOptions.damping, help="damping coefficient c0")
     args = parser.parse_args()
     if trivalve_input() is None:
         print("Texas TriValve input not found: set $SKVALVE_TRIVALVE (Mathur et al. 2022, CC BY-NC-SA 4.0)")
         return 2
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(message)s")
     args.out.mkdir(parents=True, exist_ok=True)
-    options = ClosureOptions(end=args.end)
+    options = ClosureOptions(end=args.end, damping=args.damping)
+    u0, t0 = None, 0.0
+    if args.resume:
+        state = np.load(args.out / "last_state.npz")
+        u0, t0 = state["u"], float(state["t"])
+        print(f"resuming from step time {t0:.5g}", flush=True)
     setup = closure_setup(options=options)
     print("model:", setup.model.counts(), "contact faces:", setup.contact.surface.quads.shape[0], flush=True)
     if args.verbose:
@@ -58,7 +65,8 @@ def main() -> int:
             return pairs
 
         setup.contact.active_pairs = logged_search
-    run = run_closure(setup, options, callbacks=[LastState(args.out)], progress=False, verbose=args.verbose)
+    run = run_closure(setup, options, callbacks=[LastState(args.out)], progress=False, verbose=args.verbose,
+                      u0=u0, t0=t0)
     write_log(run, args.out / "closure_log.txt")
     print(f"wall time {run.seconds:.1f} s, load steps {len(run.load_factors) - 1}, "
           f"Newton iterations {sum(run.iterations)}, contact pairs at the end "

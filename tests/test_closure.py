@@ -125,3 +125,13 @@ def test_closure_writer_writes_contact_pressure_and_stress_per_step(tmp_path):
     jac = np.einsum("ij,ij->i", np.cross(P[:, 1] - P[:, 0], P[:, 3] - P[:, 0]), P[:, 4] - P[:, 0])
     assert np.all(jac > 0)
     assert last.cell_data_dict["max_principal_cauchy"]["hexahedron"].shape == (mesh.nelements,)
+
+
+def test_a_resumed_closure_ends_where_an_uninterrupted_one_does():
+    options = ClosureOptions(papillary_steps=2, pressure_steps=2, rtol=1e-9, solver="scipy")
+    whole = run_closure(_blocks_setup(0.15), options, progress=False)
+    setup = _blocks_setup(0.15)
+    first = run_closure(setup, ClosureOptions(papillary_steps=2, end=0.5, rtol=1e-9, solver="scipy"), progress=False)
+    resumed = run_closure(_blocks_setup(0.15), options, progress=False, u0=first.u, t0=first.load_factors[-1])
+    assert resumed.load_factors == pytest.approx([0.5, 1.0, 1.5])
+    np.testing.assert_allclose(resumed.u, whole.u, atol=1e-9)

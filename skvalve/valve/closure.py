@@ -165,14 +165,17 @@ def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: Abaq
 
 
 def run_closure(setup: ClosureSetup, options: ClosureOptions | None = None, callbacks=(), progress: bool = True,
-                verbose: bool = False) -> ClosureRun:
+                verbose: bool = False, u0: np.ndarray | None = None, t0: float = 0.0) -> ClosureRun:
     """Solve the staged closure; never raises for a failed step: the run records the error and the last state.
 
     The returned :class:`ClosureRun` has the converged step times, Newton iterations and active contact pairs
     per step, wall time, peak resident memory of the process, and the undamped residual at the last converged state.
+    ``u0, t0``: resume from a converged state (e.g. the last one a run kept on disk); earlier step times are skipped.
     """
     options = options or ClosureOptions()
     run = ClosureRun()
+    if u0 is not None and setup.damping is not None:
+        setup.damping.committed_u, setup.damping.committed_t = np.array(u0, dtype=float), float(t0)
 
     def record(event: StepEvent) -> None:
         run.load_factors.append(float(event.load_factor))
@@ -184,7 +187,7 @@ def run_closure(setup: ClosureSetup, options: ClosureOptions | None = None, call
     try:
         solve(setup.problem, load_factors(options), rtol=options.rtol, max_iter=options.max_iter,
               max_cutbacks=options.max_cutbacks, solver=options.solver, progress=progress, verbose=verbose,
-              callbacks=[record, *callbacks])
+              u0=u0, t0=t0, callbacks=[record, *callbacks])
     except Exception as err:  # noqa: BLE001 - a failed closure is a result to report, with its last state
         run.error = f"{type(err).__name__}: {err}"
     finally:
