@@ -39,7 +39,7 @@ def _design_matrix(X1: Array, X2: Array) -> Array:
 
 
 def polar_2d(F: ArrayLike) -> tuple[Array, Array, Array]:
-    """Closed-form polar decomposition of 2×2 tensors ``F`` (shape (2, 2, *batch)): ``(R, U, alpha)``."""
+    """Closed-form polar decomposition of 2×2 tensors ``F`` (shape ``(2, 2, *batch)``): ``(R, U, alpha)``."""
     F = np.asarray(F, dtype=float)
     if F.ndim < 2 or F.shape[:2] != (2, 2):
         raise ValueError(f"polar_2d: F must have shape (2, 2, *batch); got {F.shape}")
@@ -66,7 +66,7 @@ class QuadraticStrainMap:
     X_max: Array
 
     def deformation_gradient(self, X1: ArrayLike, X2: ArrayLike) -> Array:
-        """F of Eq. 6 at reference points, shape (2, 2, *batch)."""
+        """F of Eq. 6 at reference points, shape ``(2, 2, *batch)``."""
         X1, X2 = np.broadcast_arrays(np.asarray(X1, dtype=float), np.asarray(X2, dtype=float))
         F = np.empty((2, 2) + X1.shape)
         for row, c in enumerate((self.a, self.b)):

@@ -129,7 +129,7 @@ class ViscousDamping(Term):
 
 def undamped_residual(problem: Problem, u: np.ndarray, t: float) -> tuple[float, float]:
     """Norm of the free-dof residual of ``problem`` without its damping terms at ``(u, t)``, and that norm
-    relative to max(|reactions|, |external forces|) (the solver's convergence measure)."""
+    relative to ``max(|reactions|, |external forces|)`` (the solver's convergence measure)."""
     n = problem.space.n_dofs
     internal, external = np.zeros(n), np.zeros(n)
     for term in problem.terms:

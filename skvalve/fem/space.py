@@ -10,14 +10,14 @@ values and the integration weights ``dx`` are evaluated once and stored contiguo
 Element families (quadrature: Gauss rules exact for the degree of the integrand of a
 linear problem on affine cells):
 
-=========  ===========================  ===========================
-mesh       ``"u"`` order 1 / 2           ``"up"`` (order 2 only)
-=========  ===========================  ===========================
-hexahedra  Q1 (2³ pts) / Q2 (3³ pts)    Q2/Q1 (3³ points)
-tetrahedra P1 (1 pt) / P2 (4 pts)       P2/P1 (4 points)
-quads (2D) Q1 (2² pts) / Q2 (3² pts)    Q2/Q1 (3² points)
-triangles  P1 (1 pt) / P2 (3 pts)       P2/P1 (3 points)
-=========  ===========================  ===========================
+==========  ===========================  ===========================
+mesh        ``"u"`` order 1 / 2           ``"up"`` (order 2 only)
+==========  ===========================  ===========================
+hexahedra   Q1 (2³ pts) / Q2 (3³ pts)    Q2/Q1 (3³ points)
+tetrahedra  P1 (1 pt) / P2 (4 pts)       P2/P1 (4 points)
+quads (2D)  Q1 (2² pts) / Q2 (3² pts)    Q2/Q1 (3² points)
+triangles   P1 (1 pt) / P2 (3 pts)       P2/P1 (3 points)
+==========  ===========================  ===========================
 
 Two-dimensional meshes are plane strain (:math:`F_{33} = 1`), quantities per unit width.
 """

@@ -40,7 +40,7 @@ class InvariantDerivatives:
 
 @dataclass(frozen=True)
 class PrincipalDerivatives:
-    r"""``first[a]`` :math:`=\partial\psi/\partial c_a` (3, *batch), ``second[a, b]`` (3, 3, *batch)."""
+    r"""``first[a]`` :math:`=\partial\psi/\partial c_a` ``(3, *batch)``, ``second[a, b]`` ``(3, 3, *batch)``."""
 
     first: Array
     second: Array

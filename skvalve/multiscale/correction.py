@@ -44,7 +44,7 @@ __all__ = ["CorrectionEffect", "CorrectionSize", "chandran_barocas_effect", "cha
 
 @dataclass
 class CorrectionSize:
-    """Per RVE: body force b (n_rves, 3) in N/m³ and ratio ρ = |b| h / |σ| (n_rves,)."""
+    """Per RVE: body force b (n_rves, 3) in N/m³ and ratio ρ = ``|b| h / |σ|`` (n_rves,)."""
 
     body_force: np.ndarray
     ratio: np.ndarray

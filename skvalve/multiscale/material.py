@@ -99,6 +99,8 @@ class RVEMaterial:
     psi, fiber_diameter : fiber volume fraction ψ and diameter (Eqs. 6–8).
     tol, max_iter : RVE force-balance tolerance and Newton iterations (see :class:`RVEBatch`).
 
+    Notes
+    -----
     The solver calls :meth:`pk1_and_tangent` with F of shape (3, 3, n_points, n_elements);
     RVE ``r = element * n_points + point``.
 

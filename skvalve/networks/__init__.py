@@ -5,7 +5,7 @@ generate    : Delaunay networks clipped to the unit RVE, matched to a target α/
 library     : seeded, cached library of networks over an α/μ grid
 rve         : RVE force balance, volume-averaged Cauchy stress (Eq. 8), consistent tangent
 rve_kernels, rve_tangent, dense_cholesky : the numba kernels (envelope Cholesky in a reverse
-              Cuthill–McKee numbering of the interior cross-links)
+Cuthill–McKee numbering of the interior cross-links)
 plotting    : Fig. 3 / Fig. 6 style plots (imported on demand: needs matplotlib)
 
 `generate` is not re-exported here: the name would shadow the submodule

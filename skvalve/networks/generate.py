@@ -176,7 +176,7 @@ def generate(
     alpha : target anisotropy index in percent (Eq. 2), 0 ≤ alpha < 95.
     mu : target mean fiber direction in degrees (Eq. 3), measured from x towards y.
     n_fibers : approximate number of fibers in the RVE, 20 ≤ n_fibers ≤ ``MAX_FIBERS``
-        (thomas2019 uses ~450: ``skvalve.papers.thomas2019.data.NETWORK.fibers_per_rve``).
+    (thomas2019 uses ~450: ``skvalve.papers.thomas2019.data.NETWORK.fibers_per_rve``).
     seed : non-negative integer; the result is a deterministic function of all arguments.
     max_attempts : sub-seeds tried, 1 ≤ max_attempts ≤ ``MAX_ATTEMPTS``.
     ``meta`` holds the targets and the achieved α, μ (float), stretch, rotation (float), seed,

@@ -1,5 +1,5 @@
 """Figures of the material catalogue: one PNG per group, uniaxial and equibiaxial Cauchy stress (or the
-force–stretch curve of a 1-D fibre), in the readable style of :mod:`.plotting`."""
+force–stretch curve of a 1-D fibre), in the readable style of :mod:`skvalve.papers.plotting`."""
 
 from __future__ import annotations
 

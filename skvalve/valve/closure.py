@@ -45,7 +45,7 @@ class ClosureOptions:
 
     penalty : contact penalty (MPa/mm): overlap ~ pressure / (2 penalty) (two-pass).
     damping : :math:`c_0` of the damping schedule (MPa·s/mm² per unit lumped volume) and ``damping_off``,
-        the step time from which it is zero.
+    the step time from which it is zero.
     papillary_steps, pressure_steps : nominal load steps over 0–0.5 and 0.5–``end``.
     end : last step time (1.5 = end-systole; less for a partial closure).
     """

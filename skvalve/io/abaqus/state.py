@@ -34,7 +34,7 @@ class ParseState:
     path: Path
     assembly: MeshScope = field(default_factory=lambda: MeshScope(""))
     parts: dict[str, MeshScope] = field(default_factory=dict)
-    #: scope of each *Part card (by id), made in the first pass over nodes and elements
+    #: scope of each ``*Part`` card (by id), made in the first pass over nodes and elements
     part_scopes: dict[int, MeshScope] = field(default_factory=dict)
     part_names: list[str] = field(default_factory=list)
     scope: MeshScope | None = None

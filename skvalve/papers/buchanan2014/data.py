@@ -5,7 +5,7 @@ Biomech Model Mechanobiol 13:813–826 (2014), doi:10.1007/s10237-013-0536-6.
 
 Units: lengths in mm, moduli in kPa (Table 1: MPa), curvatures in mm⁻¹, stretches dimensionless.
 Layers are listed bottom up: ventricularis (normalised thickness 0) to fibrosa (1).
-This module holds data only; the models built from it are in :mod:`.models`.
+This module holds data only; the models built from it are in :mod:`skvalve.papers.buchanan2014.models`.
 """
 
 from __future__ import annotations

@@ -137,7 +137,7 @@ def warping_study(curvature: float = 0.2, half_length: float = 1.2, nx: int = 8,
 
 
 def warping_versus_thickness(thicknesses=FIG11_THICKNESSES, curvatures=CURVATURES, **mesh) -> np.ndarray:
-    """Fig. 11: max |Λ1 edge − centre| (AC) for each thickness (rows) and curvature (columns)."""
+    """Fig. 11: max ``|Λ1 edge − centre|`` (AC) for each thickness (rows) and curvature (columns)."""
     out = np.empty((len(thicknesses), len(curvatures)))
     for i, h in enumerate(thicknesses):
         for j, kappa in enumerate(curvatures):

@@ -137,7 +137,7 @@ def figure_7(warp: dict, axes=None):
 
 
 def figure_11(table: np.ndarray, ax=None):
-    """Fig. 11: edge–centre warping max |ΔΛ1| versus strip thickness, one line per curvature."""
+    """Fig. 11: edge–centre warping max ``|ΔΛ1|`` versus strip thickness, one line per curvature."""
     ax = _axes(ax, 1, 6.4)[0]
     for j, curvature in enumerate(CURVATURES):
         ax.plot(FIG11_THICKNESSES, table[:, j], "o-", label=f"Δκ = {curvature} mm⁻¹")

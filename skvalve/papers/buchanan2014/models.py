@@ -1,4 +1,5 @@
-"""buchanan2014 models built from :mod:`.data`: the layered strips and their exact (Rivlin) responses.
+"""buchanan2014 models built from :mod:`skvalve.papers.buchanan2014.data`:
+the layered strips and their exact (Rivlin) responses.
 
 Layers are ``[(thickness, law), ...]`` bottom up (ventricularis first), as
 :func:`skvalve.analytic.rivlin.bend` takes them. AC bending stretches the fibrosa face (``a > 0``),

@@ -162,7 +162,7 @@ def bimodular_fe_rows(full: bool = False) -> list[Row]:
 
 
 def warping_rows(warp: dict) -> list[Row]:
-    """Fig. 7: max |Λ1 edge − centre| of the 3D quarter strip (:func:`.fe.warping_study`) beside '~0.02'."""
+    """Fig. 7: max ``|Λ1 edge − centre|`` of the 3D quarter strip (:func:`.fe.warping_study`) beside '~0.02'."""
     rows = []
     for direction in ("WC", "AC"):
         w = warp[direction]

@@ -29,7 +29,7 @@ point, and ∫σ11 (y − y_c) dy over the deformed section (Gauss points per la
 Sliding measure: straight lines fitted to Λ1 in the ventricularis and in the fibrosa, extrapolated to
 the spongiosa's mid-plane, differ by J (fibrosa − ventricularis). S = J(μS) − J(45 kPa) (the bonded
 run removes the profile's slight nonlinearity and the discretisation error). "Measurable" means
-|S| > 0.0141, the experimental error of Λ1 (Sect. 3.4): that decides whether the experiment of Fig. 10
+``|S| > 0.0141``, the experimental error of Λ1 (Sect. 3.4): that decides whether the experiment of Fig. 10
 could have seen sliding; the tracking resolution 0.001 (Appendix 1) gives a second, lower threshold.
 """
 
@@ -185,7 +185,7 @@ def sliding_study(spongiosa_moduli=SLIDING_SPONGIOSA_MODULI, curvatures=CURVATUR
 
 
 def sliding_threshold(study: dict, curvature: float, limit: float = LAMBDA_EXPERIMENT_ERROR) -> float:
-    """μS (kPa) below which |S| exceeds ``limit``: linear interpolation of |S| in log μS between the sweep's
+    """μS (kPa) below which ``|S|`` exceeds ``limit``: linear interpolation of ``|S|`` in log μS between the sweep's
     bracketing values; NaN-free — raises ValueError when the sweep does not bracket the limit."""
     moduli = np.array(sorted(study["moduli"]))
     s = np.array([abs(study["sliding"][(mu, curvature)]) for mu in moduli])

@@ -1,4 +1,5 @@
-"""mathur2022 laws in skvalve units (kPa) from the TriValve parameters of :mod:`.data` (file units: MPa)."""
+"""mathur2022 laws in skvalve units (kPa) from the TriValve parameters of
+:mod:`skvalve.papers.mathur2022.data` (file units: MPa)."""
 
 from __future__ import annotations
 

@@ -4,7 +4,7 @@ V. S. Thomas, V. Lai, R. Amini, "A computational multi-scale approach to investi
 changes in tricuspid valve anterior leaflet microstructure", Acta Biomaterialia 94 (2019) 524–535.
 
 Units: SI (Pa, m) unless the name says otherwise (``_MM``, ``_KPA``, ``_N_PER_M``, percent for α).
-This module holds data only; the models built from it are in :mod:`.models`.
+This module holds data only; the models built from it are in :mod:`skvalve.papers.thomas2019.models`.
 """
 
 from __future__ import annotations
