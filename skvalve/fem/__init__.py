@@ -36,6 +36,6 @@ from .terms import Blocks, Contribution, Term
 __all__ = [
     "Solid", "Problem", "Term", "Blocks", "Contribution", "HyperelasticTerm", "MaterialRegions", "FollowerPressure",
     "NodalForce", "Result", "Space", "solve", "StepEvent", "SolverError", "ConvergenceError",
-    "NonPositiveJacobianError", "SingularSystemError", "OutputError", "TangledMeshError", "SolverUnavailableError", "solver_name",
-    "available_solvers",
+    "NonPositiveJacobianError", "SingularSystemError", "OutputError", "TangledMeshError", "SolverUnavailableError",
+    "solver_name", "available_solvers",
 ]

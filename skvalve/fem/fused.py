@@ -31,6 +31,7 @@ from ..materials.base import Hyperelastic
 from ..materials.derivatives import InvariantDerivatives, PrincipalDerivatives
 from .constitutive import MaterialRegions, invert_volumetric
 from .fused_points import invariant_point, inverse_transpose, principal_point
+from .kernels import add_point_stiffness
 
 __all__ = ["FusedLaw", "FusedResponse", "MixedFields", "fused_response", "assemble_regions"]
 
@@ -139,27 +140,8 @@ def _fused_kernel(kind, F, D, aux, has_direction, dN, dx, tangent, pressure, Np,
                         fe[e, nu + al] += w * Np[e, q, al] * (Jbar[q, e] - J)
             if not tangent:
                 continue
-            # G[a,i,k,L] = w dN[a,J] A[i,J,k,L]; K[ai,bk] += G[a,i,k,L] dN[b,L] (upper triangle)
-            for a in range(nb):
-                for i in range(dim):
-                    for k in range(dim):
-                        for L in range(dim):
-                            s = 0.0
-                            for J_ in range(dim):
-                                s += dN[e, q, a, J_] * A[i, J_, k, L]
-                            Gw[a, i, k, L] = w * s
-            for a in range(nb):
-                for i in range(dim):
-                    row = a * dim + i
-                    for b in range(a, nb):
-                        for k in range(dim):
-                            col = b * dim + k
-                            if col < row:
-                                continue
-                            s = 0.0
-                            for L in range(dim):
-                                s += Gw[a, i, k, L] * dN[e, q, b, L]
-                            ke[e, row, col] += s
+            # K[ai,bk] += w dN[a,J] A[i,J,k,L] dN[b,L] (upper triangle; mirrored after the loop)
+            add_point_stiffness(ke[e], dN[e, q], A, w, Gw)
             if mixed:
                 for a in range(nb):
                     for i in range(dim):

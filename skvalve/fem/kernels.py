@@ -67,6 +67,37 @@ def element_forces(P: np.ndarray, dN: np.ndarray, dx: np.ndarray) -> np.ndarray:
     return f
 
 
+@njit(cache=True)
+def add_point_stiffness(ke: np.ndarray, dNq: np.ndarray, A: np.ndarray, w: float, G: np.ndarray) -> None:
+    r"""Add :math:`w\,\partial_J N_a\,\mathbb{A}_{iJkL}\,\partial_L N_b` into the upper triangle of ``ke``.
+
+    One quadrature point of an element: ``ke`` (at least nb*d square) indexed ``[a*d+i, b*d+k]``,
+    ``dNq`` (nb, d) the shape-function gradients, ``A`` (>= d)^4 the tangent dP/dF, ``w`` the weight,
+    ``G`` an (nb, d, d, d) scratch array. Shared by :func:`element_stiffness` and the fused kernels.
+    """
+    nb, dim = dNq.shape
+    for a in range(nb):
+        for i in range(dim):
+            for k in range(dim):
+                for L in range(dim):
+                    s = 0.0
+                    for J in range(dim):
+                        s += dNq[a, J] * A[i, J, k, L]
+                    G[a, i, k, L] = w * s
+    for a in range(nb):
+        for i in range(dim):
+            row = a * dim + i
+            for b in range(a, nb):
+                for k in range(dim):
+                    col = b * dim + k
+                    if col < row:
+                        continue
+                    s = 0.0
+                    for L in range(dim):
+                        s += G[a, i, k, L] * dNq[b, L]
+                    ke[row, col] += s
+
+
 @njit(parallel=True, cache=True)
 def element_stiffness(A: np.ndarray, dN: np.ndarray, dx: np.ndarray, ke: np.ndarray) -> None:
     r"""Add ``sum_q dx dN[a,J] A[e,q,i,J,k,L] dN[b,L]`` into ``ke[e, a*d+i, b*d+k]``.
@@ -79,34 +110,8 @@ def element_stiffness(A: np.ndarray, dN: np.ndarray, dx: np.ndarray, ke: np.ndar
     nel, nqp, nb, dim = dN.shape
     for e in prange(nel):
         G = np.empty((nb, dim, dim, dim))
-        Ae = np.empty((dim, dim, dim, dim))
         for q in range(nqp):
-            w = dx[e, q]
-            for i in range(dim):
-                for J in range(dim):
-                    for k in range(dim):
-                        for L in range(dim):
-                            Ae[i, J, k, L] = w * A[e, q, i, J, k, L]
-            for a in range(nb):
-                for i in range(dim):
-                    for k in range(dim):
-                        for L in range(dim):
-                            s = 0.0
-                            for J in range(dim):
-                                s += dN[e, q, a, J] * Ae[i, J, k, L]
-                            G[a, i, k, L] = s
-            for a in range(nb):
-                for i in range(dim):
-                    row = a * dim + i
-                    for b in range(a, nb):
-                        for k in range(dim):
-                            col = b * dim + k
-                            if col < row:
-                                continue
-                            s = 0.0
-                            for L in range(dim):
-                                s += G[a, i, k, L] * dN[e, q, b, L]
-                            ke[e, row, col] += s
+            add_point_stiffness(ke[e], dN[e, q], A[e, q], dx[e, q], G)
         # major symmetry of A makes the block symmetric: mirror the upper triangle
         for row in range(nb * dim):
             for col in range(row + 1, nb * dim):
