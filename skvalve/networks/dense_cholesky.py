@@ -32,21 +32,28 @@ from skvalve.networks.network import Network
 FAST = {"reassoc", "contract", "nsz", "arcp"}
 
 
+@njit(cache=True, fastmath=FAST, inline="always")
+def _factor_row(a: np.ndarray, i: int, j_start: int, f_i: int, first: np.ndarray) -> bool:
+    """Entries a[i, j_start..i] of the lower factor (row i's envelope starts at ``f_i``); False if not SPD."""
+    for j in range(j_start, i + 1):
+        t = a[i, j]
+        for k in range(max(f_i, first[j]), j):
+            t -= a[i, k] * a[j, k]
+        if j < i:
+            a[i, j] = t / a[j, j]
+        elif t > 0.0:
+            a[i, i] = math.sqrt(t)
+        else:
+            return False
+    return True
+
+
 @njit(cache=True, fastmath=FAST)
 def cholesky_in_place(a: np.ndarray, n: int, first: np.ndarray) -> bool:
     """Lower Cholesky factor of the envelope of a[:n, :n], in place; False if not SPD."""
     for i in range(n):
-        fi = first[i]
-        for j in range(fi, i + 1):
-            t = a[i, j]
-            for k in range(max(fi, first[j]), j):
-                t -= a[i, k] * a[j, k]
-            if j < i:
-                a[i, j] = t / a[j, j]
-            elif t > 0.0:
-                a[i, i] = math.sqrt(t)
-            else:
-                return False
+        if not _factor_row(a, i, first[i], first[i], first):
+            return False
     return True
 
 
@@ -68,17 +75,9 @@ def node_cholesky_in_place(a: np.ndarray, n: int, first: np.ndarray) -> bool:
                 t2 -= a[I + 2, k] * ajk
             d = a[j, j]
             a[I, j], a[I + 1, j], a[I + 2, j] = t0 / d, t1 / d, t2 / d
-        for i in range(I, I + 3):  # the node's own 3×3 diagonal block
-            for j in range(I, i + 1):
-                t = a[i, j]
-                for k in range(f, j):
-                    t -= a[i, k] * a[j, k]
-                if j < i:
-                    a[i, j] = t / a[j, j]
-                elif t > 0.0:
-                    a[i, i] = math.sqrt(t)
-                else:
-                    return False
+        for i in range(I, I + 3):  # the node's own 3×3 diagonal block (first[j] = f there)
+            if not _factor_row(a, i, I, f, first):
+                return False
     return True
 
 
