@@ -320,14 +320,14 @@ for fe in studies.values():
           f"M/Rivlin − 1 = {errors[-1][0]:+.2%}, NA/Rivlin − 1 = {errors[-1][1]:+.2%}")
 orders = np.log2(np.abs(np.array(errors[0]) / np.array(errors[1])))
 print(f"observed order of the moment and neutral-axis errors: {orders[0]:.2f}, {orders[1]:.2f}")
-assert all(abs(m) < 0.03 and abs(na) < 0.02 for m, na in errors)
+assert all(abs(m) < 0.025 and abs(na) < 0.02 for m, na in errors)  # "to about 2 %"
 assert np.all((0.5 < orders) & (orders < 1.5))  # first order, see below
 assert all(abs(fe["axial_force"]) < 1e-6 * force_scale for fe in studies.values())
 
 
 # %% [markdown]
-# The FE agrees with Rivlin at the curvature it has at mid-length (the rigid end face disturbs a zone about one
-# thickness long), to 2 % on the coarsest mesh. The error
+# The FE agrees with Rivlin at the curvature it has at mid-length (the rigid end face disturbs the strip next to
+# it), to about 2 % on the coarsest mesh. The error
 # falls at first order, not second: the continuous Q1 pressure cannot jump at the layer interfaces where the modulus
 # jumps (for a homogeneous strip it is second order, see `tests/test_buchanan2014.py`).
 # `skvalve.papers.buchanan2014.fe.fe_pure_bending` wraps this model for the reproduction table and the finer meshes of
