@@ -193,3 +193,16 @@ def test_vertices_without_cells_keep_their_coordinates():
     space = Space(skfem.MeshHex(p, mesh.t + 1))
     assert np.allclose(space.dof_coordinates[:, 0], [2.0, 3.0, 4.0])
     assert np.allclose(space.dof_coordinates[:, 1:9], mesh.p)
+
+
+def test_absolute_floor_decides_unloaded_steps():
+    """A stage with no load (pressure switched on at t > 0.5): relative residuals are round-off / round-off;
+    atol decides those steps, and the loaded ones still meet rtol."""
+    def build():
+        return Solid(box(2), LAW).add_dirichlet("left", 0.0).add_pressure("right", lambda t: 0.05 * max(t - 0.5, 0))
+
+    with pytest.raises(ValueError, match="atol"):
+        build().solve(steps=4, progress=False, atol=-1.0)
+    result = build().solve(steps=[0.25, 0.5, 0.75, 1.0], progress=False, atol=1e-10)
+    assert result.load_factors == [0.0, 0.25, 0.5, 0.75, 1.0]
+    assert np.abs(result.u(2)).max() == 0.0 and np.abs(result.u()).max() > 1e-3

@@ -16,11 +16,12 @@ re-evaluated). A step :math:`u^{k+1} = u^k + \alpha\,\Delta u` is accepted for t
 
 .. math::
 
-    \frac{\lVert R_f \rVert}{\max(\lVert R_D\rVert, \lVert f_\text{ext}\rVert)} \le \text{rtol}
+    \lVert R_f \rVert \le \max\big(\text{rtol}\,\max(\lVert R_D\rVert, \lVert f_\text{ext}\rVert),\ \text{atol}\big)
     \quad\text{and (optional)}\quad
     \frac{|\Delta u^k\cdot R^{k-1}|}{|\Delta u^1\cdot R^0|} \le \text{energy\_tol},
 
-with :math:`R_D` the reactions. A step that fails (too many iterations, :math:`J \le 0`,
+with :math:`R_D` the reactions (``atol``, in force units, decides steps whose loads and reactions
+vanish, e.g. a stage before the pressure is applied). A step that fails (too many iterations, :math:`J \le 0`,
 singular tangent) is retried with half the increment, up to ``max_cutbacks`` times, after
 :meth:`~skvalve.fem.problem.Problem.rewind`; a converged step is
 :meth:`~skvalve.fem.problem.Problem.commit`-ted, stored in a :class:`Result` and handed to the
@@ -61,6 +62,7 @@ class NewtonOptions:
     """Validated options of :func:`solve`."""
 
     rtol: float = 1e-8
+    atol: float = 0.0
     energy_tol: float | None = None
     max_iter: int = 25
     max_cutbacks: int = 6
@@ -73,6 +75,8 @@ class NewtonOptions:
     def __post_init__(self) -> None:
         if not (isinstance(self.rtol, int | float) and math.isfinite(self.rtol) and self.rtol > 0):
             raise ValueError(f"rtol must be a positive finite number; got {self.rtol!r}")
+        if not (isinstance(self.atol, int | float) and math.isfinite(self.atol) and self.atol >= 0):
+            raise ValueError(f"atol must be a finite number >= 0; got {self.atol!r}")
         if self.energy_tol is not None and not (
             isinstance(self.energy_tol, int | float) and math.isfinite(self.energy_tol) and self.energy_tol > 0
         ):
@@ -150,7 +154,7 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
     reference = _reference(problem, residual, fixed)
     norm = np.linalg.norm(rhs[free])
     history = []
-    if not moved and norm <= opts.rtol * reference:
+    if not moved and norm <= max(opts.rtol * reference, opts.atol):
         return u, residual, history, tangent
     energy0, last_error = None, None
     for iteration in range(1, opts.max_iter + 1):
@@ -202,7 +206,8 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
                   f"|du|={record['increment']:.3e} energy={relative_energy:.3e} alpha={alpha:g}")
         if not np.isfinite(norm):
             raise _StepFailed("residual is not finite")
-        if relative <= opts.rtol and (opts.energy_tol is None or relative_energy <= opts.energy_tol):
+        energy_ok = opts.energy_tol is None or relative_energy <= opts.energy_tol
+        if (relative <= opts.rtol or norm <= opts.atol) and energy_ok:
             return u, residual, history, tangent
     raise _StepFailed(f"no convergence in {opts.max_iter} iterations (relative residual {relative:.3e})")
 
@@ -218,17 +223,18 @@ def _notify(callbacks, event: StepEvent) -> None:
             raise error from err
 
 
-def solve(problem: Problem, steps=10, *, rtol: float = 1e-8, energy_tol: float | None = None, max_iter: int = 25,
-          max_cutbacks: int = 6, line_search: bool = True, max_line_search: int = 4, solver: str | None = None,
-          progress: bool = True, verbose: bool = False, u0: np.ndarray | None = None, t0: float = 0.0,
-          callbacks: Sequence[Callable[[StepEvent], None]] = ()) -> Result:
+def solve(problem: Problem, steps=10, *, rtol: float = 1e-8, atol: float = 0.0, energy_tol: float | None = None,
+          max_iter: int = 25, max_cutbacks: int = 6, line_search: bool = True, max_line_search: int = 4,
+          solver: str | None = None, progress: bool = True, verbose: bool = False, u0: np.ndarray | None = None,
+          t0: float = 0.0, callbacks: Sequence[Callable[[StepEvent], None]] = ()) -> Result:
     """Solve the load path ``t`` in ``steps`` (int: uniform steps to 1; or increasing factors).
 
     Parameters
     ----------
     problem : the :class:`~skvalve.fem.problem.Problem` (e.g. a :class:`~skvalve.fem.Solid`).
     steps : number of uniform load steps to ``t = 1``, or the increasing load factors to reach.
-    rtol, energy_tol : convergence tolerances (relative residual; optional relative energy).
+    rtol, atol, energy_tol : convergence tolerances (relative residual, absolute residual floor in force
+        units, optional relative energy).
     max_iter, max_cutbacks, line_search, max_line_search : Newton controls.
     solver : sparse backend (``"pardiso"``, ``"umfpack"``, ``"scipy"``; default the fastest).
     progress, verbose : a progress bar over load steps; a line per iteration.
@@ -247,7 +253,7 @@ def solve(problem: Problem, steps=10, *, rtol: float = 1e-8, energy_tol: float |
     NonPositiveJacobianError, ConvergenceError, SingularSystemError
         When a step fails after ``max_cutbacks`` halvings (all carry ``last_converged``).
     """
-    opts = NewtonOptions(rtol, energy_tol, max_iter, max_cutbacks, line_search, max_line_search,
+    opts = NewtonOptions(rtol, atol, energy_tol, max_iter, max_cutbacks, line_search, max_line_search,
                          linsolve.solver_name(solver), verbose)
     if not (isinstance(t0, int | float) and math.isfinite(t0) and t0 >= 0):
         raise ValueError(f"t0 must be a finite load factor >= 0; got {t0!r}")
