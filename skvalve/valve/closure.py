@@ -48,6 +48,8 @@ class ClosureOptions:
     the step time from which it is zero.
     papillary_steps, pressure_steps : nominal load steps over 0–0.5 and 0.5–``end``.
     end : last step time (1.5 = end-systole; less for a partial closure).
+    rtol, atol : Newton tolerances: relative to reactions/loads, and an absolute floor (N) for the papillary
+        stage, whose loads and reactions are nearly zero (pressure load at the end: about 8 N).
     """
 
     penalty: float = 1.0
@@ -59,6 +61,7 @@ class ClosureOptions:
     max_cutbacks: int = 8
     max_iter: int = 30
     rtol: float = 1e-6
+    atol: float = 1e-6
     solver: str | None = None
 
 
@@ -185,7 +188,7 @@ def run_closure(setup: ClosureSetup, options: ClosureOptions | None = None, call
 
     start = time.perf_counter()
     try:
-        solve(setup.problem, load_factors(options), rtol=options.rtol, max_iter=options.max_iter,
+        solve(setup.problem, load_factors(options), rtol=options.rtol, atol=options.atol, max_iter=options.max_iter,
               max_cutbacks=options.max_cutbacks, solver=options.solver, progress=progress, verbose=verbose,
               u0=u0, t0=t0, callbacks=[record, *callbacks])
     except Exception as err:  # noqa: BLE001 - a failed closure is a result to report, with its last state
