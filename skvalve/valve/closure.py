@@ -49,7 +49,7 @@ class ClosureOptions:
     papillary_steps, pressure_steps : nominal load steps over 0–0.5 and 0.5–``end``.
     end : last step time (1.5 = end-systole; less for a partial closure).
     rtol, atol : Newton tolerances: relative to reactions/loads, and an absolute floor (N) for the papillary
-        stage, whose loads and reactions are nearly zero (pressure load at the end: about 8 N).
+    stage, whose loads and reactions are nearly zero (pressure load at the end: about 8 N).
     """
 
     penalty: float = 1.0
