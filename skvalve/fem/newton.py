@@ -51,6 +51,8 @@ logger = logging.getLogger("skvalve.fem")
 
 #: linear solves whose relative residual exceeds this are taken as singular
 _LINEAR_RESIDUAL_LIMIT = 1e-6
+#: a line search that cannot reduce |R| still takes its shortest step, unless |R| grows by more than this factor
+_BLOW_UP = 1e2
 
 
 class _StepFailed(Exception):
@@ -184,7 +186,14 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
             finally:
                 opts.timings["assembly"] += time.perf_counter() - start
             trial_norm = np.linalg.norm(trial_residual[free])
-            if not opts.line_search or trial_norm <= norm or alpha < 2.0 ** -opts.max_line_search * 1.5:
+            if not opts.line_search or trial_norm <= norm:
+                accepted = (trial, trial_residual, trial_tangent, trial_norm)
+                break
+            if alpha < 2.0 ** -opts.max_line_search * 1.5:
+                # no length reduced |R|: take the shortest one unless the residual blows up (then cut back)
+                if not trial_norm <= _BLOW_UP * norm:
+                    raise _StepFailed(f"line search: the residual grows from {norm:.3e} to {trial_norm:.3e} even at "
+                                      f"step length {alpha:g}")
                 accepted = (trial, trial_residual, trial_tangent, trial_norm)
                 break
             alpha *= 0.5
