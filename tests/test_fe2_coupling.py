@@ -12,8 +12,6 @@ from _fe2_networks import affine_network
 
 from skvalve.fem import ConvergenceError, Solid, solve
 from skvalve.fem.meshes import box
-from skvalve.materials.exponential_fiber import ExponentialFiber
-from skvalve.materials.neo_hookean import NeoHookean
 from skvalve.multiscale.affine import AffineFiberModel
 from skvalve.multiscale.material import RVEMaterial
 from skvalve.networks.generate import generate
@@ -21,16 +19,6 @@ from skvalve.networks.rve import solve_rve
 
 G, NU, E_F, BETA, LAMBDA_C, DIAMETER = 2.1e3, 0.49, 10.5e3, 50.5, 1.12, 450e-9
 TIGHT = 1e-13  # RVE tolerance for checks at the 1e-10 / finite-difference level
-
-
-@pytest.fixture(scope="module")
-def fiber():
-    return ExponentialFiber.from_diameter(E_F, DIAMETER, BETA, LAMBDA_C)
-
-
-@pytest.fixture(scope="module")
-def matrix():
-    return NeoHookean.from_shear_poisson(G, NU)
 
 
 @pytest.fixture(scope="module")

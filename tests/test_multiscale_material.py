@@ -10,8 +10,6 @@ import numpy as np
 import pytest
 from _fe2_networks import affine_network
 
-from skvalve.materials.exponential_fiber import ExponentialFiber
-from skvalve.materials.neo_hookean import NeoHookean
 from skvalve.multiscale.affine import AffineFiberModel
 from skvalve.multiscale.material import RVEMaterial, cauchy_to_pk1
 from skvalve.networks.generate import generate
@@ -21,16 +19,6 @@ from skvalve.networks.rve import solve_rve
 # model parameters of the order of the paper's (SI units); the checks hold for any values
 G, NU, E_F, BETA, LAMBDA_C, DIAMETER = 2.1e3, 0.49, 10.5e3, 50.5, 1.12, 450e-9
 TOL = 1e-12  # RVE force balance, tight so that 1e-10 comparisons and finite differences are meaningful
-
-
-@pytest.fixture(scope="module")
-def fiber():
-    return ExponentialFiber.from_diameter(E_F, DIAMETER, BETA, LAMBDA_C)
-
-
-@pytest.fixture(scope="module")
-def matrix():
-    return NeoHookean.from_shear_poisson(G, NU)
 
 
 @pytest.fixture(scope="module")

@@ -23,7 +23,7 @@ import numpy as np
 from ..fem.fields import element_centres
 from ..fem.newton import StepEvent
 
-__all__ = ["TimeSeriesWriter", "step_fields"]
+__all__ = ["TimeSeriesWriter", "step_fields", "replace_atomically"]
 
 _CELL_TYPES = {"hex": "hexahedron", "tet": "tetra", "quad": "quad", "tri": "triangle"}
 
@@ -50,7 +50,11 @@ def step_fields(problem, u: np.ndarray, centres) -> tuple[dict, dict]:
     return point_data, cell_data
 
 
-def _replace(path: Path, write) -> None:
+def replace_atomically(path: Path, write) -> None:
+    """Call ``write(temporary)`` for a temporary file beside ``path``, then rename it to ``path``.
+
+    An interrupted write never leaves a partial file under the final name; the temporary is removed.
+    """
     temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp{path.suffix}")
     try:
         write(temporary)
@@ -92,7 +96,7 @@ class TimeSeriesWriter:
         name = f"{self.path.stem}_{len(self.entries):04d}.vtu"
         target = self.path.parent / name
         mesh = meshio.Mesh(self.points, self.cells, point_data, cell_data)
-        _replace(target, lambda p: meshio.write(p, mesh, file_format="vtu"))
+        replace_atomically(target, lambda p: meshio.write(p, mesh, file_format="vtu"))
         self.entries.append((float(t), name))
         self._write_collection()
         return target
@@ -101,7 +105,7 @@ class TimeSeriesWriter:
         lines = ['<?xml version="1.0"?>', '<VTKFile type="Collection" version="0.1">', "  <Collection>"]
         lines += [f'    <DataSet timestep="{t!r}" part="0" file="{name}"/>' for t, name in self.entries]
         lines += ["  </Collection>", "</VTKFile>", ""]
-        _replace(self.path, lambda p: p.write_text("\n".join(lines)))
+        replace_atomically(self.path, lambda p: p.write_text("\n".join(lines)))
 
     def close(self) -> None:
         """Nothing is held open; called by the solver at the end."""

@@ -17,7 +17,6 @@ plus the ``.pvd`` collection, every file written under a temporary name and rena
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -27,6 +26,7 @@ import scipy.sparse as sp
 
 from ..fem.fields import element_centres
 from ..fem.newton import StepEvent
+from ..io.timeseries import replace_atomically
 from .closure import ClosureSetup
 from .geometry import annulus_nodes, leaflet_surfaces, valve_areas
 from .model import ABAQUS_TO_SKFEM_HEX
@@ -109,16 +109,6 @@ def max_principal_cauchy(setup: ClosureSetup, u: np.ndarray) -> np.ndarray:
     return np.linalg.eigvalsh(sigma.transpose(2, 0, 1))[:, -1]
 
 
-def _replace(path: Path, write) -> None:
-    temporary = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")
-    try:
-        write(temporary)
-        os.replace(temporary, path)
-    finally:
-        if temporary.exists():
-            temporary.unlink()
-
-
 class ClosureWriter:
     """Solver callback: ``<stem>_<k>.vtu`` per converged step and ``<stem>.pvd`` (module docstring)."""
 
@@ -147,12 +137,12 @@ class ClosureWriter:
         name = f"{self.path.stem}_{len(self.entries):04d}.vtu"
         target = self.path.parent / name
         mesh = meshio.Mesh(self.points, self.cells, point_data, cell_data)
-        _replace(target, lambda p: meshio.write(p, mesh, file_format="vtu"))
+        replace_atomically(target, lambda p: meshio.write(p, mesh, file_format="vtu"))
         self.entries.append((float(t), name))
         lines = ['<?xml version="1.0"?>', '<VTKFile type="Collection" version="0.1">', "  <Collection>"]
         lines += [f'    <DataSet timestep="{t!r}" part="0" file="{n}"/>' for t, n in self.entries]
         lines += ["  </Collection>", "</VTKFile>", ""]
-        _replace(self.path, lambda p: p.write_text("\n".join(lines)))
+        replace_atomically(self.path, lambda p: p.write_text("\n".join(lines)))
         return target
 
     def close(self) -> None:
