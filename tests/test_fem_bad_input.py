@@ -17,6 +17,7 @@ from skvalve.fem import (
     Solid,
     Space,
     TangledMeshError,
+    solve,
 )
 from skvalve.fem.meshes import box
 from skvalve.materials import NeoHookean
@@ -206,3 +207,36 @@ def test_absolute_floor_decides_unloaded_steps():
     result = build().solve(steps=[0.25, 0.5, 0.75, 1.0], progress=False, atol=1e-10)
     assert result.load_factors == [0.0, 0.25, 0.5, 0.75, 1.0]
     assert np.abs(result.u(2)).max() == 0.0 and np.abs(result.u()).max() > 1e-3
+
+
+def test_line_search_refuses_a_step_that_blows_the_residual_up():
+    """A term whose reported tangent is 1000x too soft sends Newton far off: even the shortest line-search step
+    makes |R| grow ~1e5-fold (finite), which must end in a cut-back (finally ConvergenceError naming it), never an
+    accepted state (before the guard, the shortest step was taken whatever |R| became)."""
+    from skvalve.fem import Blocks, Contribution
+
+    class WrongTangent:
+        load_dependent, symmetric, supports, name = True, True, True, "cubic springs"
+
+        def __init__(self, space):
+            self.dofs = np.arange(space.n_dofs).reshape(-1, 1)
+
+        def connectivity(self):
+            return [self.dofs]
+
+        def assemble(self, u, t, tangent, step):
+            internal = u + u**3 - t  # exact tangent 1 + 3u^2; reported 1000x too small
+            k = 1e-3 * (1.0 + 3.0 * u**2)[:, None, None] if tangent else None
+            return Contribution(internal=internal, external=None, blocks=[Blocks(self.dofs, k)])
+
+        def commit(self):
+            pass
+
+        def rewind(self):
+            pass
+
+    space = Space(box(1))
+    problem = Problem(space, [WrongTangent(space)])
+    with pytest.raises(ConvergenceError, match="residual grows") as info:
+        solve(problem, steps=1, progress=False, max_cutbacks=2, max_iter=3)
+    assert info.value.last_converged.load_factors == [0.0]
