@@ -48,6 +48,7 @@ from numba import njit, prange
 from ..kinematics import determinant
 from .constitutive import MaterialRegions
 from .errors import NonPositiveJacobianError
+from .fused_points import inverse_transpose
 from .kernels import element_gradients
 from .space import Space
 from .terms import Blocks, Contribution, Term
@@ -66,19 +67,6 @@ def fbar_deformation(F: np.ndarray, dx: np.ndarray) -> tuple[np.ndarray, np.ndar
     return alpha * F, alpha
 
 
-@njit(cache=True)
-def _inverse_transpose(F: np.ndarray, out: np.ndarray) -> float:
-    """``out = F^{-T}`` for a 3x3 ``F``; returns det F."""
-    a, b, c = F[0, 0], F[0, 1], F[0, 2]
-    d, e, f = F[1, 0], F[1, 1], F[1, 2]
-    g, h, k = F[2, 0], F[2, 1], F[2, 2]
-    J = a * (e * k - f * h) - b * (d * k - f * g) + c * (d * h - e * g)
-    out[0, 0], out[0, 1], out[0, 2] = (e * k - f * h) / J, (f * g - d * k) / J, (d * h - e * g) / J
-    out[1, 0], out[1, 1], out[1, 2] = (c * h - b * k) / J, (a * k - c * g) / J, (b * g - a * h) / J
-    out[2, 0], out[2, 1], out[2, 2] = (b * f - c * e) / J, (c * d - a * f) / J, (a * e - b * d) / J
-    return J
-
-
 @njit(parallel=True, cache=True)
 def fbar_element_response(F, Pbar, A, dN, dx, tangent):
     """Element forces (nel, 3 nb) and, if ``tangent``, matrices (nel, 3 nb, 3 nb) (module docstring).
@@ -95,7 +83,7 @@ def fbar_element_response(F, Pbar, A, dN, dx, tangent):
         GB = np.zeros((nqp, m))  # G_q : B_q
         volume, deformed = 0.0, 0.0
         for q in range(nqp):
-            J[q] = _inverse_transpose(F[:, :, q, e], G[q])
+            J[q] = inverse_transpose(F[:, :, q, e], G[q])
             volume += dx[e, q]
             deformed += dx[e, q] * J[q]
             for a in range(nb):
