@@ -54,7 +54,7 @@ from ..materials.exponential_fiber import ExponentialFiber
 from ..materials.neo_hookean import NeoHookean
 from ..networks.network import Network
 from ..networks.rve import RVEBatch
-from .material import RVEFailure, RVEMaterial, RVEMaterialState
+from .material import RVEFailure, RVEMaterial, RVEMaterialState, checked_inputs
 
 if TYPE_CHECKING:  # only for the annotation: the module runs on whatever client it is handed
     from distributed import Client, Future
@@ -193,17 +193,7 @@ class DistributedRVEMaterial(RVEMaterial):
         state: RVEMaterialState | None = None,
     ) -> None:
         # RVEMaterial.__init__ is not called: it would build and solve every RVE in this process
-        if not isinstance(matrix, NeoHookean):
-            raise TypeError(f"DistributedRVEMaterial: matrix must be a NeoHookean (Eq. 10), "
-                            f"got {type(matrix).__name__}")
-        if isinstance(n_points, bool) or int(n_points) != n_points or n_points < 1:
-            raise ValueError(f"DistributedRVEMaterial: n_points must be a positive integer, got {n_points!r}")
-        networks = list(networks)
-        if not networks:
-            raise ValueError("DistributedRVEMaterial: no networks given (one per element is needed)")
-        for e, net in enumerate(networks):
-            if not isinstance(net, Network):
-                raise TypeError(f"DistributedRVEMaterial: networks[{e}] is a {type(net).__name__}, not a Network")
+        networks = checked_inputs("DistributedRVEMaterial", networks, matrix, n_points)
         workers = sorted(client.nthreads())
         if not workers:
             raise ValueError("DistributedRVEMaterial: the client has no workers")

@@ -85,6 +85,21 @@ def cauchy_to_pk1(F: np.ndarray, sigma: np.ndarray, dsigma_dF: np.ndarray | None
     return P, A
 
 
+def checked_inputs(owner: str, networks: Sequence[Network], matrix, n_points) -> list[Network]:
+    """The networks as a list, after checking the matrix law, ``n_points`` and every network (named errors)."""
+    if not isinstance(matrix, NeoHookean):
+        raise TypeError(f"{owner}: matrix must be a NeoHookean (Eq. 10), got {type(matrix).__name__}")
+    if isinstance(n_points, bool) or int(n_points) != n_points or n_points < 1:
+        raise ValueError(f"{owner}: n_points must be a positive integer, got {n_points!r}")
+    networks = list(networks)
+    if not networks:
+        raise ValueError(f"{owner}: no networks given (one per element is needed)")
+    for e, net in enumerate(networks):
+        if not isinstance(net, Network):
+            raise TypeError(f"{owner}: networks[{e}] is a {type(net).__name__}, not a Network")
+    return networks
+
+
 class RVEMaterial:
     """Matrix (Eq. 10) plus fiber-network RVE (Eq. 8) at every quadrature point, evaluated in batch.
 
@@ -124,16 +139,7 @@ class RVEMaterial:
         tol: float = 1e-10,
         max_iter: int = 30,
     ) -> None:
-        if not isinstance(matrix, NeoHookean):
-            raise TypeError(f"RVEMaterial: matrix must be a NeoHookean (Eq. 10), got {type(matrix).__name__}")
-        if isinstance(n_points, bool) or int(n_points) != n_points or n_points < 1:
-            raise ValueError(f"RVEMaterial: n_points must be a positive integer, got {n_points!r}")
-        networks = list(networks)
-        if not networks:
-            raise ValueError("RVEMaterial: no networks given (one per element is needed)")
-        for e, net in enumerate(networks):
-            if not isinstance(net, Network):
-                raise TypeError(f"RVEMaterial: networks[{e}] is a {type(net).__name__}, not a Network")
+        networks = checked_inputs("RVEMaterial", networks, matrix, n_points)
         self.matrix, self.fiber = matrix, fiber
         self.psi, self.fiber_diameter, self.tol = psi, fiber_diameter, tol
         self.n_elements, self.n_points = len(networks), int(n_points)
