@@ -74,3 +74,22 @@ def test_gauss_point_writer_round_trip(tmp_path):
     sigma = gauss_fields(solid, material, result.u()).cauchy.mean(axis=2)  # (3, 3, nel)
     np.testing.assert_allclose(last.cell_data["cauchy"][0].reshape(-1, 3, 3), sigma.transpose(2, 0, 1))
     np.testing.assert_array_equal(last.cell_data["alpha"][0], [30.0, 45.0])
+
+
+def test_generic_problem_checkpoint_carries_the_rve_states(tmp_path):
+    """skvalve.io.checkpoint (any Problem) stores the RVE states through the solid term and resumes to the
+    same result as the uninterrupted run."""
+    from skvalve.io.checkpoint import Checkpoint as ProblemCheckpoint
+    from skvalve.io.checkpoint import resume as resume_problem
+
+    solid, material = build()
+    straight = solve(solid, steps=STEPS, progress=False)
+    solid2, _ = build()
+    with pytest.raises(OutputError):
+        solve(solid2, steps=STEPS, progress=False, callbacks=[ProblemCheckpoint(tmp_path), StopAfter(2)])
+    solid3, material3 = build()
+    t0, u0 = resume_problem(solid3, tmp_path)
+    assert t0 == 0.5
+    resumed = solve(solid3, steps=STEPS, u0=u0, t0=t0, progress=False)
+    assert np.abs(resumed.u() - straight.u()).max() <= 1e-12 * np.abs(straight.u()).max()
+    assert np.abs(material3.state().positions - material.state().positions).max() <= 1e-12

@@ -117,21 +117,21 @@ class HyperelasticTerm(Term):
                 rewind()
 
     def state(self) -> dict[str, np.ndarray]:
-        """Committed state of the regions' materials that have one (``material.state()``)."""
+        """Committed state of the regions' materials that have one (``material.checkpoint_arrays()``)."""
         out = {}
         for k, region in enumerate(self.materials.regions):
-            getter = getattr(region.material, "state", None)
+            getter = getattr(region.material, "checkpoint_arrays", None)
             if getter is not None:
                 out.update({f"region{k}.{name}": value for name, value in getter().items()})
         return out
 
     def restore(self, arrays: dict[str, np.ndarray]) -> None:
-        """Hand each region's material its arrays from :meth:`state`."""
+        """Hand each region's material its arrays from :meth:`state` (``material.restore_arrays``)."""
         for k, region in enumerate(self.materials.regions):
             prefix = f"region{k}."
             mine = {key[len(prefix):]: value for key, value in arrays.items() if key.startswith(prefix)}
-            restore = getattr(region.material, "restore", None)
+            restore = getattr(region.material, "restore_arrays", None)
             if restore is not None:
                 restore(mine)
             elif mine:
-                raise ValueError(f"material of region {k} has saved state but no restore()")
+                raise ValueError(f"material of region {k} has saved state but no restore_arrays()")

@@ -88,4 +88,5 @@ class Term:
         """Return to the last committed state (after a failed attempt)."""
 
     # Optional, for checkpoints (skvalve.io.checkpoint): ``state() -> dict[str, ndarray]`` returns the
-    # committed state and ``restore(arrays)`` sets it (and commits). Terms without state omit both.
+    # committed state and ``restore(arrays)`` sets it (and commits). Terms without state omit both. The solid
+    # term forwards both to quadrature-point materials as ``checkpoint_arrays()`` / ``restore_arrays(arrays)``.

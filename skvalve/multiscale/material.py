@@ -251,6 +251,14 @@ class RVEMaterial:
         b = self.batch
         return RVEMaterialState(b.positions.copy(), b.F_state.copy(), b.sensitivity.copy(), self._stretch.copy())
 
+    def checkpoint_arrays(self) -> dict[str, np.ndarray]:
+        """The committed state as named arrays (what :class:`skvalve.fem.HyperelasticTerm` checkpoints)."""
+        return dict(vars(self.state()))
+
+    def restore_arrays(self, arrays: dict[str, np.ndarray]) -> None:
+        """Restore arrays from :meth:`checkpoint_arrays` (same networks)."""
+        self.set_state(RVEMaterialState(**arrays))
+
     def set_state(self, state: RVEMaterialState) -> None:
         """Restore a committed state saved by :meth:`state` (same networks)."""
         b = self.batch
