@@ -14,7 +14,6 @@ one and :func:`resume` restores the terms and returns ``(t0, u0)`` for
 
 from __future__ import annotations
 
-import os
 import re
 import zipfile
 from pathlib import Path
@@ -23,6 +22,7 @@ import numpy as np
 
 from ..fem.newton import StepEvent
 from ..fem.problem import Problem
+from .files import replace_atomically
 
 __all__ = ["Checkpoint", "latest", "resume"]
 
@@ -53,14 +53,8 @@ class Checkpoint:
             return
         index = self._offset + event.step
         path = self.folder / f"step_{index:05d}.npz"
-        temporary = self.folder / f".step_{index:05d}.{os.getpid()}.tmp.npz"
         arrays = {f"term/{key}": value for key, value in event.problem.state().items()}
-        try:
-            np.savez(temporary, load_factor=np.float64(event.load_factor), u=event.u, **arrays)
-            os.replace(temporary, path)
-        finally:
-            if temporary.exists():
-                temporary.unlink()
+        replace_atomically(path, lambda p: np.savez(p, load_factor=np.float64(event.load_factor), u=event.u, **arrays))
 
 
 def _last_index(folder: Path) -> int:

@@ -14,7 +14,6 @@ Use::
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import meshio
@@ -22,8 +21,9 @@ import numpy as np
 
 from ..fem.fields import element_centres
 from ..fem.newton import StepEvent
+from .files import replace_atomically
 
-__all__ = ["TimeSeriesWriter", "step_fields", "replace_atomically"]
+__all__ = ["TimeSeriesWriter", "step_fields"]
 
 _CELL_TYPES = {"hex": "hexahedron", "tet": "tetra", "quad": "quad", "tri": "triangle"}
 
@@ -48,20 +48,6 @@ def step_fields(problem, u: np.ndarray, centres) -> tuple[dict, dict]:
         "J": [np.linalg.det(F.transpose(2, 0, 1))],
     }
     return point_data, cell_data
-
-
-def replace_atomically(path: Path, write) -> None:
-    """Call ``write(temporary)`` for a temporary file beside ``path``, then rename it to ``path``.
-
-    An interrupted write never leaves a partial file under the final name; the temporary is removed.
-    """
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp{path.suffix}")
-    try:
-        write(temporary)
-        os.replace(temporary, path)
-    finally:
-        if temporary.exists():
-            temporary.unlink()
 
 
 class TimeSeriesWriter:

@@ -12,12 +12,12 @@ uninterrupted one.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ..io.files import replace_atomically
 from .material import RVEMaterial, RVEMaterialState
 
 __all__ = ["Checkpoint", "CheckpointData", "load_checkpoint", "resume"]
@@ -62,13 +62,8 @@ class Checkpoint:
             if key in arrays or key in ("u", "step", "load_factor"):
                 raise ValueError(f"Checkpoint: extra array name {key!r} is reserved")
         arrays.update({f"extra_{key}": np.asarray(value) for key, value in extra.items()})
-        temporary = self.path.with_name(f".{self.path.stem}.{os.getpid()}.tmp.npz")
-        try:
-            np.savez(temporary, u=event.u, step=event.step, load_factor=event.load_factor, **arrays)
-            os.replace(temporary, self.path)
-        finally:
-            if temporary.exists():
-                temporary.unlink()
+        replace_atomically(self.path, lambda p: np.savez(p, u=event.u, step=event.step,
+                                                         load_factor=event.load_factor, **arrays))
         self.written += 1
 
 

@@ -8,13 +8,13 @@ element averages for the VTU cell data. Files are written under a temporary name
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import meshio
 import numpy as np
 
+from ..io.files import replace_atomically
 from ..kinematics import green_lagrange
 
 __all__ = ["GaussFields", "gauss_fields", "GaussPointWriter"]
@@ -75,20 +75,12 @@ class GaussPointWriter:
         data = meshio.Mesh(mesh.p.T, [("hexahedron", mesh.t.T)], point_data={"displacement": disp}, cell_data=cells)
         name = f"{self.path.stem}_{len(self.entries):04d}.vtu"
         target = self.path.with_name(name)
-        _atomic(target, lambda tmp: meshio.write(tmp, data, file_format="vtu"))
+        replace_atomically(target, lambda tmp: meshio.write(tmp, data, file_format="vtu"))
         self.entries.append((float(t), name))
         lines = ['<?xml version="1.0"?>', '<VTKFile type="Collection" version="0.1">', "  <Collection>"]
         lines += [f'    <DataSet timestep="{time:.10g}" file="{file}"/>' for time, file in self.entries]
         lines += ["  </Collection>", "</VTKFile>", ""]
-        _atomic(self.path, lambda tmp: Path(tmp).write_text("\n".join(lines)))
+        replace_atomically(self.path, lambda tmp: Path(tmp).write_text("\n".join(lines)))
         return target
 
 
-def _atomic(path: Path, write) -> None:
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp{path.suffix}")
-    try:
-        write(str(temporary))
-        os.replace(temporary, path)
-    finally:
-        if temporary.exists():
-            temporary.unlink()

@@ -10,12 +10,12 @@ the final name.
 from __future__ import annotations
 
 import contextlib
-import os
-import secrets
 from collections.abc import Iterator
 from pathlib import Path
 
 import matplotlib
+
+from ..io.files import replace_atomically
 
 __all__ = ["DPI", "MIN_WIDTH_IN", "MIN_FONT_PT", "STYLE", "readable_style", "save_figure"]
 
@@ -52,13 +52,5 @@ def save_figure(fig, path: Path, dpi: int = DPI) -> Path:
     width = fig.get_size_inches()[0]
     if width < MIN_WIDTH_IN:
         raise ValueError(f"figure for {path.name} is {width:.1f} in wide; at least {MIN_WIDTH_IN} in are readable")
-    # a unique name in the same folder (same file system for the rename); created by savefig with the
-    # umask's permissions (mkstemp would leave the final file readable by its owner only)
-    temporary = path.with_name(f".{path.stem}.{os.getpid()}.{secrets.token_hex(4)}.png.part")
-    try:
-        fig.savefig(temporary, format="png", dpi=dpi)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
-    return path
+    # created by savefig with the umask's permissions (mkstemp would leave it readable by its owner only)
+    return replace_atomically(path, lambda temporary: fig.savefig(temporary, format="png", dpi=dpi))

@@ -26,7 +26,7 @@ import scipy.sparse as sp
 
 from ..fem.fields import element_centres
 from ..fem.newton import StepEvent
-from ..io.timeseries import replace_atomically
+from ..io.files import replace_atomically
 from .closure import ClosureSetup
 from .geometry import annulus_nodes, leaflet_surfaces, valve_areas
 from .model import ABAQUS_TO_SKFEM_HEX
