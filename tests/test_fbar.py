@@ -8,13 +8,22 @@ import skfem
 from skvalve.fem import FollowerPressure, Problem, Solid, Space, solve
 from skvalve.fem.fbar import FBarTerm
 from skvalve.fem.meshes import box, distort
-from skvalve.materials import LeeSacks, NeoHookean
+from skvalve.materials import LeeSacks, NeoHookean, Ogden
 
 # the shipped Texas TriValve anterior-leaflet law (C0, C1, C2, D): bulk/shear modulus ~ 100, nu ~ 0.495
 LEAFLET = LeeSacks(1.0e-3, 1.188659e-4, 15.260081, 20.0669)
 
 
-@pytest.mark.parametrize("law", [NeoHookean(1.0, 20.0), LeeSacks(1.0, 2.0, 0.5, 0.02)])
+class _UncompiledNeoHookean(NeoHookean):
+    """Overrides the stress without stating its invariant derivatives: no fused form, the generic path."""
+
+    def response_C(self, C):
+        return super().response_C(C)
+
+
+@pytest.mark.parametrize("law", [NeoHookean(1.0, 20.0), LeeSacks(1.0, 2.0, 0.5, 0.02),
+                                 Ogden(mu=(1.0, 0.2), alpha=(2.5, -2.0), D=(0.05,)), _UncompiledNeoHookean(1.0, 20.0)],
+                         ids=["neo_hookean", "lee_sacks", "ogden", "generic_path"])
 def test_fbar_tangent_matches_central_differences_and_forces_match_the_energy(law):
     space = Space(distort(box(2)))
     term = FBarTerm(space, law)
@@ -34,6 +43,21 @@ def test_fbar_tangent_matches_central_differences_and_forces_match_the_energy(la
         return float((law.psi(term.modified_deformation_gradient(w)) * space.dx.T).sum())
 
     assert (energy(u + h * v) - energy(u - h * v)) / (2 * h) == pytest.approx(contribution.internal @ v, rel=1e-7)
+
+
+@pytest.mark.parametrize("amplitude", [0.01, 0.06])
+def test_compiled_laws_give_the_generic_residual_and_tangent(amplitude):
+    """Two laws on interleaved elements: P and dP/dF at F_bar by the fused kernel vs MaterialRegions.evaluate."""
+    mesh = distort(box(3), amount=0.2, seed=2)
+    space = Space(mesh)
+    laws, regions = [LEAFLET, Ogden(mu=(1.0, 0.2), alpha=(2.5, -2.0), D=(0.05,))], np.arange(mesh.nelements) % 2
+    fused, generic = FBarTerm(space, laws, regions), FBarTerm(space, laws, regions, fused=False)
+    u = amplitude * np.random.default_rng(3).standard_normal(space.n_dofs)
+    got, expected = fused.assemble(u, 0.0, True, 0), generic.assemble(u, 0.0, True, 0)
+    assert np.abs(got.internal - expected.internal).max() <= 1e-12 * np.abs(expected.internal).max()
+    K, K_generic = got.blocks[0].matrices, expected.blocks[0].matrices
+    assert np.abs(K - K_generic).max() <= 1e-12 * np.abs(K_generic).max()
+    assert np.array_equal(fused.assemble(u, 0.0, False, 0).internal, got.internal)
 
 
 def test_fbar_patch_test_reproduces_a_homogeneous_deformation():

@@ -48,6 +48,7 @@ from numba import njit, prange
 from ..kinematics import determinant
 from .constitutive import MaterialRegions
 from .errors import NonPositiveJacobianError
+from .fused import point_response_regions
 from .fused_points import inverse_transpose
 from .kernels import element_gradients
 from .space import Space
@@ -175,16 +176,20 @@ class FBarTerm(Term):
     materials : a law, ``{subdomain: law}`` or a sequence of laws with ``regions`` (as for ``Solid``), or
         a ready :class:`~skvalve.fem.constitutive.MaterialRegions`.
     regions : element -> material index, with a sequence of laws.
+    fused : evaluate P and dP/dF at F_bar with the compiled laws of
+        :mod:`skvalve.fem.fused` (:func:`~skvalve.fem.fused.point_response_regions`) when every law has
+        one; otherwise, or with ``False``, through :meth:`~skvalve.fem.constitutive.MaterialRegions.evaluate`.
     """
 
     name = "F-bar solid"
 
-    def __init__(self, space: Space, materials, regions: np.ndarray | None = None) -> None:
+    def __init__(self, space: Space, materials, regions: np.ndarray | None = None, fused: bool = True) -> None:
         if space.family != "hex" or space.order != 1 or space.formulation != "u":
             raise ValueError("F-bar needs trilinear hexahedra: a hex mesh with formulation='u', order=1")
         self.space = space
         self.materials = materials if isinstance(materials, MaterialRegions) else MaterialRegions(
             space.mesh, materials, regions, mixed=False)
+        self.fused = fused
 
     def connectivity(self) -> list[np.ndarray]:
         return [self.space.element_dofs]
@@ -206,7 +211,8 @@ class FBarTerm(Term):
         if np.any(bad):
             raise NonPositiveJacobianError(np.flatnonzero(bad.any(axis=0)), step, t, self.name)
         Fbar, _ = fbar_deformation(F, sp_.dx)
-        Pbar, A, _ = self.materials.evaluate(Fbar, None, tangent)
+        response = point_response_regions(self.materials, Fbar, tangent) if self.fused else None
+        Pbar, A = response if response is not None else self.materials.evaluate(Fbar, None, tangent)[:2]
         if not np.all(np.isfinite(Pbar)):
             raise NonPositiveJacobianError(np.flatnonzero(~np.isfinite(Pbar).all(axis=(0, 1, 2))), step, t, self.name)
         # one compiled signature: contiguous arrays throughout

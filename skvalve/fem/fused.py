@@ -33,7 +33,8 @@ from .constitutive import MaterialRegions, invert_volumetric
 from .fused_points import invariant_point, inverse_transpose, principal_point
 from .kernels import add_point_stiffness
 
-__all__ = ["FusedLaw", "FusedResponse", "MixedFields", "fused_response", "assemble_regions"]
+__all__ = ["FusedLaw", "FusedResponse", "MixedFields", "fused_response", "assemble_regions",
+           "point_response_regions"]
 
 _INVARIANT, _PRINCIPAL = 0, 1
 
@@ -65,6 +66,63 @@ class FusedResponse:
 # ----------------------------------------------------------------------------- kernel
 
 
+@njit(cache=True, inline="always")
+def _point_scratch(n_derivatives):
+    """Per-thread scratch of :func:`_law_point`: Fq, H, S, Pq, A, Dq, Vq, aq, G3, M3, B3, c3."""
+    return (np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.zeros((3, 3, 3, 3)),
+            np.empty(n_derivatives), np.empty((3, 3)), np.zeros(3), np.empty((3, 3)), np.empty((3, 3)),
+            np.empty((3, 3, 3)), np.empty(3))
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _law_point(kind, F, D, aux, has_direction, q, e, Fq, H, Dq, aq, Vq, S, Pq, A, tangent, G3, M3, B3, c3):
+    """Point (q, e): Fq = F[:, :, q, e], H = Fq^{-T}, S, A = dP/dF (if ``tangent``), Pq = Fq S; returns det Fq.
+
+    The other 3x3 / 3-vector arguments are scratch arrays (see :mod:`skvalve.fem.fused_points`).
+    """
+    for i in range(3):
+        for j in range(3):
+            Fq[i, j] = F[i, j, q, e]
+    for r in range(D.shape[0]):
+        Dq[r] = D[r, q, e]
+    J = inverse_transpose(Fq, H)
+    if kind == _INVARIANT:
+        if has_direction:
+            for i in range(3):
+                aq[i] = aux[i, 0, q, e]
+        invariant_point(Fq, H, J, Dq, aq, has_direction, S, A, tangent, G3, M3, B3)
+    else:
+        for i in range(3):
+            for j in range(3):
+                Vq[i, j] = aux[i, j, q, e]
+        principal_point(Fq, Dq, Vq, S, A, tangent, c3, M3, G3)
+    for i in range(3):
+        for j in range(3):
+            s = 0.0
+            for K in range(3):
+                s += Fq[i, K] * S[K, j]
+            Pq[i, j] = s
+    return J
+
+
+@njit(parallel=True, cache=True, error_model="numpy")
+def _point_kernel(kind, F, D, aux, has_direction, tangent):
+    """P[i, J, q, e] and, if ``tangent``, A[e, q, i, J, k, L] = dP_iJ/dF_kL at every point."""
+    nqp, nel = F.shape[2], F.shape[3]
+    P = np.empty((3, 3, nqp, nel))
+    A_all = np.empty((nel if tangent else 0, nqp, 3, 3, 3, 3))
+    for e in prange(nel):
+        Fq, H, S, Pq, A, Dq, Vq, aq, G3, M3, B3, c3 = _point_scratch(D.shape[0])
+        for q in range(nqp):
+            _law_point(kind, F, D, aux, has_direction, q, e, Fq, H, Dq, aq, Vq, S, Pq, A, tangent, G3, M3, B3, c3)
+            for i in range(3):
+                for j in range(3):
+                    P[i, j, q, e] = Pq[i, j]
+            if tangent:
+                A_all[e, q] = A
+    return P, A_all
+
+
 @njit(parallel=True, cache=True, error_model="numpy")
 def _fused_kernel(kind, F, D, aux, has_direction, dN, dx, tangent, pressure, Np, Jbar, compliance, ndofe):
     nel, nqp, nb, dim = dN.shape
@@ -76,42 +134,11 @@ def _fused_kernel(kind, F, D, aux, has_direction, dN, dx, tangent, pressure, Np,
     fe = np.zeros((nel, ndofe))
     ke = np.zeros((nel if tangent else 0, ndofe, ndofe))
     for e in prange(nel):
-        Fq = np.empty((3, 3))
-        H = np.empty((3, 3))
-        S = np.empty((3, 3))
-        Pq = np.empty((3, 3))
-        A = np.zeros((3, 3, 3, 3))
+        Fq, H, S, Pq, A, Dq, Vq, aq, G3, M3, B3, c3 = _point_scratch(D.shape[0])
         Gw = np.empty((nb, dim, dim, dim))
-        Dq = np.empty(D.shape[0])
-        Vq = np.empty((3, 3))
-        aq = np.zeros(3)
-        G3 = np.empty((3, 3))
-        M3 = np.empty((3, 3))
-        B3 = np.empty((3, 3, 3))
-        c3 = np.empty(3)
         for q in range(nqp):
-            for i in range(3):
-                for j in range(3):
-                    Fq[i, j] = F[i, j, q, e]
-            for r in range(D.shape[0]):
-                Dq[r] = D[r, q, e]
-            J = inverse_transpose(Fq, H)
-            if kind == _INVARIANT:
-                if has_direction:
-                    for i in range(3):
-                        aq[i] = aux[i, 0, q, e]
-                invariant_point(Fq, H, J, Dq, aq, has_direction, S, A, tangent, G3, M3, B3)
-            else:
-                for i in range(3):
-                    for j in range(3):
-                        Vq[i, j] = aux[i, j, q, e]
-                principal_point(Fq, Dq, Vq, S, A, tangent, c3, M3, G3)
-            for i in range(3):
-                for j in range(3):
-                    s = 0.0
-                    for K in range(3):
-                        s += Fq[i, K] * S[K, j]
-                    Pq[i, j] = s
+            J = _law_point(kind, F, D, aux, has_direction, q, e, Fq, H, Dq, aq, Vq, S, Pq, A, tangent, G3, M3, B3,
+                           c3)
             if mixed:
                 p = pressure[q, e]
                 for i in range(3):
@@ -230,6 +257,17 @@ class FusedLaw:
                                   pressure, Np, Jbar, compliance, int(ndofe))
         return FusedResponse(P, fe, ke if tangent else None)
 
+    def point_response(self, F: np.ndarray, tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """``P`` (3,3,nqp,nel) and ``A[e, q, i, J, k, L]`` :math:`= \\partial P_{iJ}/\\partial F_{kL}` (None unless
+        ``tangent``) at every point of ``F`` (3,3,nqp,nel): the layout of
+        :meth:`~skvalve.fem.constitutive.MaterialRegions.evaluate`, one compiled loop."""
+        F = np.ascontiguousarray(F, dtype=float)
+        if F.ndim != 4 or F.shape[:2] != (3, 3):
+            raise ValueError(f"F must have shape (3, 3, nqp, nel); got {F.shape}")
+        D, aux, has_direction = self._derivatives(F)
+        P, A = _point_kernel(self.kind, F, np.ascontiguousarray(D), aux, has_direction, bool(tangent))
+        return P, (A if tangent else None)
+
 
 def fused_response(law) -> FusedLaw | None:
     """The compiled evaluator of ``law``, or ``None`` when the law has no fused form (use the generic path).
@@ -249,6 +287,39 @@ def fused_response(law) -> FusedLaw | None:
     return None
 
 
+def _fused_laws(materials: MaterialRegions) -> list[FusedLaw] | None:
+    """The compiled evaluator of every region's law, or ``None`` if one has no fused form."""
+    fused = [fused_response(region.law) for region in materials.regions]
+    return None if any(f is None for f in fused) else fused
+
+
+def _single_region(materials: MaterialRegions) -> bool:
+    return len(materials.regions) == 1 and isinstance(materials.regions[0].elements, slice)
+
+
+def point_response_regions(materials: MaterialRegions, F: np.ndarray,
+                           tangent: bool) -> tuple[np.ndarray, np.ndarray | None] | None:
+    """``(P, A)`` of every region through :meth:`FusedLaw.point_response`, or ``None`` if a region has no fused form.
+
+    The same as ``materials.evaluate(F, None, tangent)[:2]`` (P (3,3,nqp,nel), A (nel,nqp,3,3,3,3) or None):
+    the stress of each region's law (its isochoric part in the mixed formulation) and its derivative.
+    """
+    fused = _fused_laws(materials)
+    if fused is None:
+        return None
+    if _single_region(materials):
+        return fused[0].point_response(F, tangent)
+    nqp, nel = F.shape[2], F.shape[3]
+    P = np.empty((3, 3, nqp, nel))
+    A = np.empty((nel, nqp, 3, 3, 3, 3)) if tangent else None
+    for region, evaluate in zip(materials.regions, fused, strict=True):
+        Pr, Ar = evaluate.point_response(F[:, :, :, region.elements], tangent)
+        P[:, :, :, region.elements] = Pr
+        if tangent:
+            A[region.elements] = Ar
+    return P, A
+
+
 def assemble_regions(materials: MaterialRegions, F: np.ndarray, space, tangent: bool,
                      pressure: np.ndarray | None = None) -> FusedResponse | None:
     """Every material region of ``materials`` through the fused kernel, or ``None`` if one region has no fused form.
@@ -257,11 +328,11 @@ def assemble_regions(materials: MaterialRegions, F: np.ndarray, space, tangent: 
     (nqp, nel) given), ``Np``; the result holds the full element forces and stiffness of the solid
     term including the pressure rows (:math:`\bar J - J` and :math:`-1/U''` blocks).
     """
-    fused = [fused_response(region.law) for region in materials.regions]
-    if any(f is None for f in fused):
+    fused = _fused_laws(materials)
+    if fused is None:
         return None
     nel, nqp = space.nel, space.dx.shape[1]
-    single = len(materials.regions) == 1 and isinstance(materials.regions[0].elements, slice)
+    single = _single_region(materials)
     P = None if single else np.empty((3, 3, nqp, nel))
     forces = None if single else np.empty((nel, space.ndofe))
     stiffness = None if single or not tangent else np.empty((nel, space.ndofe, space.ndofe))

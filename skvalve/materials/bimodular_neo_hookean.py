@@ -121,7 +121,8 @@ class BimodularNeoHookean(IsotropicInvariantLaw):
         return mu, d_mu, dd_mu
 
     def _structure_tensor(self, C: Array) -> Array:
-        a = self.direction.reshape(self.direction.shape + (1,) * (C.ndim - 1 - self.direction.ndim))
+        a = self.direction  # batch axes aligned from the right, as in fibre_stretch_squared
+        a = a.reshape((3,) + (1,) * (C.ndim - 1 - a.ndim) + a.shape[1:])
         return np.broadcast_to(np.einsum("I...,J...->IJ...", a, a), C.shape)
 
     def energy_C(self, C: Array) -> Array:
