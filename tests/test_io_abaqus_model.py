@@ -200,6 +200,9 @@ def test_ignored_keywords_are_listed_with_lines(model):
     ("*Output, field", "*Frobnicate, field", "not supported"),
     ("Bottom, PlateTop", "Bottom, Nowhere", "unknown surface"),
     ("0.65, 5", "-0.65, 5", "positive thickness"),
+    ("LINK, RP, Tip", "LINK, RP", "an MPC line is"),
+    ("LINK, RP, Tip", "LINK, Tip, Tip", "joins a node to itself"),
+    ("LINK, RP, Tip", "LINK, Tip, Block-1.Bottom", "1 and 4 node"),
 ])
 def test_bad_input_names_file_line_and_keyword(tmp_path, old, new, message):
     assert old in DECK
@@ -210,6 +213,27 @@ def test_bad_input_names_file_line_and_keyword(tmp_path, old, new, message):
     assert "bad.inp:" in str(info.value)
     line = info.value.location.line
     assert 1 <= line <= DECK.count("\n") + 1
+
+
+def test_link_mpc_pairs_a_node_set_with_one_node(tmp_path):
+    """``LINK, p, a`` with a set p and one node a pairs every node of p with a (in set order)."""
+    path = tmp_path / "links.inp"
+    path.write_text(DECK.replace("LINK, RP, Tip", "LINK, Block-1.Bottom, RP", 1))
+    model = read_model(path)
+    (mpc,) = model.mpcs
+    pairs = mpc.pairs()
+    assert model.node_labels[pairs[:, 0]].tolist() == [1, 2, 3, 4]
+    assert model.node_scopes[pairs[:, 1]].tolist() == [model.scopes.index("")] * 4
+    assert model.node_labels[pairs[:, 1]].tolist() == [1] * 4
+    assert mpc.location.line == DECK.splitlines().index("LINK, RP, Tip") + 1
+
+
+def test_link_mpc_of_a_set_with_itself_names_the_data_line(tmp_path):
+    path = tmp_path / "links.inp"
+    path.write_text(DECK.replace("LINK, RP, Tip", "LINK, Block-1.Bottom, Block-1.Bottom", 1))
+    with pytest.raises(AbaqusParseError, match="itself") as info:
+        read_model(path)
+    assert info.value.location.line == DECK.splitlines().index("LINK, RP, Tip") + 1
 
 
 def test_redefined_element_keeps_last_definition_with_a_warning(tmp_path):

@@ -19,7 +19,10 @@ r"""A whole-valve model for the implicit solver, built from an Abaqus input (Tex
   shell node holds the whole fibre of extruded nodes through the thickness; rotational dofs and nodes
   that are not part of the model (rigid clip surfaces, reference points) are skipped and noted;
 * **pressure**: each ``*Dsload`` ``P`` on an element-face surface as a follower pressure (load
-  stiffness included) on the corresponding mesh facets, magnitude times its amplitude.
+  stiffness included) on the corresponding mesh facets, magnitude times its amplitude;
+* **LINK MPCs** (the 1.0 annuloplasty ring): stiff penalty bars between the linked vertices, axial
+  rigidity ``link_factor`` times the stiffest chord's, so a link's relative length change is its force over
+  that rigidity (:mod:`.links`); other ``*MPC`` types are refused with their file line.
 
 The solver's load factor is the **step time** (0 to the step's time period): ``solve(problem,
 steps=times)``. Mesh vertices are numbered chordae-only nodes first, then the leaflet nodes, because
@@ -49,6 +52,7 @@ from ..materials import LeeSacks
 from ..materials.uniaxial import OgdenUniaxial, TensionOnly
 from .chordae import CollapsedChordae, collapse_chains
 from .extrude import extrude_shell, hex_corner_jacobians
+from .links import LINK_FACTOR, Links, link_constraints, link_nodes
 
 __all__ = ["ValveModel", "NodalCondition", "PressureLoad", "Chordae", "valve_model"]
 
@@ -123,6 +127,7 @@ class ValveModel:
     end_time: float
     vertex_source: np.ndarray
     notes: list[str] = field(default_factory=list)
+    links: Links | None = None
 
     def counts(self) -> dict[str, int]:
         """Sizes: hexes, vertices, cables, collapsed chain nodes, dropped bars, conditions, pressure facets."""
@@ -131,7 +136,8 @@ class ValveModel:
                 "cables": int(self.chordae.ends.shape[0]), "collapsed_chain_nodes": int(red.interior_nodes.size),
                 "dropped_bars": int(red.dropped_bars.size),
                 "constrained_dofs": int(sum(c.vertices.size for c in self.conditions)),
-                "pressure_facets": int(sum(p.facets.size for p in self.pressures))}
+                "pressure_facets": int(sum(p.facets.size for p in self.pressures)),
+                "links": self.links.size if self.links is not None else 0}
 
     def submodel(self, regions: list[int]) -> ValveModel:
         """The leaflets of the given region numbers alone: their hexes, conditions and pressure, and the cables
@@ -163,7 +169,8 @@ class ValveModel:
         names = ", ".join(self.region_names[r] for r in regions)
         return ValveModel(self.source, mesh, self.element_source[keep], self.regions[keep], self.region_names,
                           self.laws, chordae, conditions, pressures, self.end_time, self.vertex_source[used],
-                          self.notes + [f"submodel of {names}: {int(inside.sum())} of {inside.size} cables kept"])
+                          self.notes + [f"submodel of {names}: {int(inside.sum())} of {inside.size} cables kept"],
+                          self.links.subset(new) if self.links is not None else None)
 
     def problem(self, solid: str = "fbar", slack_fraction: float = 1e-6, transition: float = 0.01) -> Problem:
         """A :class:`~skvalve.fem.Problem` of the model (load factor = step time).
@@ -189,6 +196,8 @@ class ValveModel:
         if ch.ends.shape[0]:
             problem.add_term(Truss(space, ch.ends, ch.area, cables, ch.law_index, ch.rest_length, ch.slack_stretch,
                                    name="chordae"))
+        if self.links is not None and self.links.size:
+            problem.add_term(self.links.term(space))
         for load in self.pressures:
             problem.add_term(FollowerPressure(space, load.facets, load.at))
         for condition in self.conditions:
@@ -239,8 +248,9 @@ def _chord_law(abaqus: AbaqusModel, name: str) -> OgdenUniaxial:
     return OgdenUniaxial(tuple(data[0:2 * n:2]), tuple(data[1:2 * n:2]))
 
 
-def valve_model(abaqus: AbaqusModel, layers: int = 4, step: int = 0) -> ValveModel:
-    """Build the :class:`ValveModel` of step ``step`` of ``abaqus`` (shells extruded into ``layers`` hexes)."""
+def valve_model(abaqus: AbaqusModel, layers: int = 4, step: int = 0, link_factor: float = LINK_FACTOR) -> ValveModel:
+    """Build the :class:`ValveModel` of step ``step`` of ``abaqus`` (shells extruded into ``layers`` hexes; LINK
+    MPCs with ``link_factor`` times the stiffest chord's axial rigidity)."""
     notes: list[str] = []
     elem_type = np.empty(abaqus.n_elements, dtype=object)
     elem_conn: dict[int, np.ndarray] = {}
@@ -300,7 +310,8 @@ def valve_model(abaqus: AbaqusModel, layers: int = 4, step: int = 0) -> ValveMod
     step_obj = abaqus.steps[step] if abaqus.steps else None
     bcs = list(abaqus.boundary_conditions) + (list(step_obj.boundary_conditions) if step_obj else [])
     bc_nodes = np.unique(np.concatenate([bc.nodes for bc in bcs])) if bcs else np.zeros(0, dtype=np.int64)
-    anchored = np.union1d(np.fromiter(solid_vertex_of.keys(), dtype=np.int64), bc_nodes)
+    linked = link_nodes(abaqus)
+    anchored = np.union1d(np.union1d(np.fromiter(solid_vertex_of.keys(), dtype=np.int64), bc_nodes), linked)
     reduction = collapse_chains(bars_arr, abaqus.nodes, anchored, group_arr)
     if reduction.dropped_bars.size:
         notes.append(f"chordae: dropped {reduction.dropped_bars.size} dangling bar(s) at node(s) "
@@ -325,6 +336,11 @@ def valve_model(abaqus: AbaqusModel, layers: int = 4, step: int = 0) -> ValveMod
     chordae = Chordae(ends, reduction.rest_length, np.asarray(areas, dtype=float)[reduction.group], reduction.group,
                       [_chord_law(abaqus, name) for name in law_names], law_names, reduction,
                       np.minimum(reduction.straight_length / reduction.rest_length, 1.0))
+    chord_rigidity = max((law.young_modulus * a for law, a in zip(chordae.laws, areas, strict=True)), default=None)
+    links = link_constraints(abaqus, vertex_of, points, chord_rigidity, link_factor)
+    if links.size:
+        notes.append(f"{links.size} LINK MPC(s) as penalty bars, EA = {links.rigidity:.4g} N ({link_factor:g} x the "
+                     "stiffest chord's)")
 
     # ---------------------------------------------------------------- conditions and pressure
     amplitudes = _amplitudes(abaqus)
@@ -374,7 +390,7 @@ def valve_model(abaqus: AbaqusModel, layers: int = 4, step: int = 0) -> ValveMod
     if step_obj is not None and len(abaqus.steps) > 1:
         notes.append(f"only step {step} ({step_obj.name!r}) modelled; {len(abaqus.steps) - 1} other step(s) not")
     return ValveModel(str(abaqus.path), mesh, sources, regions, region_names, laws, chordae, conditions, pressures,
-                      end_time, vertex_source, notes)
+                      end_time, vertex_source, notes, links)
 
 
 def _facet_lookup(mesh: skfem.MeshHex) -> dict[tuple[int, ...], int]:

@@ -33,6 +33,7 @@ from .errors import AbaqusParseError, Location
 from .materials import AbaqusMaterial, MaterialOption
 from .model import (
     MPC,
+    TWO_NODE_MPC_TYPES,
     AbaqusModel,
     Amplitude,
     BoundaryCondition,
@@ -63,6 +64,7 @@ __all__ = [
     "SurfaceFaces", "Section", "Instance", "Amplitude", "BoundaryCondition", "DistributedLoad", "ConcentratedLoad",
     "ContactPair", "GeneralContact", "SurfaceInteraction", "MPC", "RigidBody", "ConnectorSection", "Transform",
     "Step", "IgnoredKeyword", "ReadWarning", "IGNORED_KEYWORDS", "HEX_FACE_NODES", "NODES_PER_ELEMENT",
+    "TWO_NODE_MPC_TYPES",
 ]
 
 #: Where the shared Texas TriValve data are looked for, relative to the repository root.

@@ -29,8 +29,12 @@ __all__ = [
     "ElementBlock", "NodeSet", "ElementSet", "SurfaceFaces", "Surface", "Section", "Instance", "Amplitude",
     "BoundaryCondition", "DistributedLoad", "ConcentratedLoad", "ContactPair", "GeneralContact",
     "SurfaceInteraction", "MPC", "RigidBody", "ConnectorSection", "Transform", "Step", "IgnoredKeyword", "ReadWarning",
-    "AbaqusModel",
+    "AbaqusModel", "TWO_NODE_MPC_TYPES",
 ]
+
+#: ``*MPC`` types that join a node ``p`` to a node ``a`` (Abaqus Analysis User's Guide, "General multi-point
+#: constraints"); ``LINK`` keeps their distance constant (pinned rigid link).
+TWO_NODE_MPC_TYPES = ("LINK", "PIN", "TIE", "BEAM")
 
 @dataclass
 class ElementBlock:
@@ -213,12 +217,24 @@ class SurfaceInteraction:
 
 @dataclass
 class MPC:
-    """One ``*MPC`` data line: type (``LINK``, ``TIE``, ``BEAM``, ...) and the node groups it ties."""
+    """One ``*MPC`` data line: type (``LINK``, ``TIE``, ``BEAM``, ...) and the node groups it ties.
+
+    For the two-node types (:data:`TWO_NODE_MPC_TYPES`: ``LINK``, ``PIN``, ``TIE``, ``BEAM``; Abaqus writes
+    ``type, p, a``) the reader checks that there are two groups, of equal size or with a single node ``a``; node
+    ``k`` of the first group is paired with node ``k`` of the second, or with ``a`` (:meth:`pairs`).
+    """
 
     mpc_type: str
     targets: tuple[str, ...]
     nodes: list[np.ndarray]
     location: Location
+
+    def pairs(self) -> np.ndarray:
+        """(n, 2) global node indices ``(p, a)`` of a two-node MPC type."""
+        if self.mpc_type not in TWO_NODE_MPC_TYPES:
+            raise ValueError(f"{self.location}: MPC {self.mpc_type} does not join pairs of nodes")
+        p, a = (np.asarray(group, dtype=np.int64) for group in self.nodes)
+        return np.column_stack([p, np.broadcast_to(a, p.shape)])
 
 
 @dataclass

@@ -9,6 +9,7 @@ from .lexer import Card, data_values, parse_float, parse_int, split_fields
 from .mesh_cards import resolve_elements, resolve_nodes
 from .model import (
     MPC,
+    TWO_NODE_MPC_TYPES,
     Amplitude,
     BoundaryCondition,
     ConcentratedLoad,
@@ -217,7 +218,17 @@ def read_mpc(card: Card, state: ParseState) -> None:
         if len(fields) < 3 or not all(fields):
             raise card.error("an MPC line is: type, node or set, node or set[, ...]", line.location)
         nodes = [resolve_nodes(f, scope, card, line.location) for f in fields[1:]]
-        state.mpcs.append(MPC(fields[0].upper(), tuple(fields[1:]), nodes, line.location))
+        kind = fields[0].upper()
+        if kind in TWO_NODE_MPC_TYPES:
+            if len(nodes) != 2 or len(nodes[1]) not in (1, len(nodes[0])):
+                raise card.error(f"MPC {kind} joins node p to node a (node sets: of equal size, or a single node a); "
+                                 f"got {' and '.join(str(len(n)) for n in nodes)} node(s) in {', '.join(fields[1:])}",
+                                 line.location)
+            same = np.flatnonzero(np.asarray(nodes[0]) == np.asarray(nodes[1]))  # broadcasts a single a
+            if same.size:
+                raise card.error(f"MPC {kind} joins a node to itself ({fields[1]} and {fields[2]}, pair "
+                                 f"{int(same[0])})", line.location)
+        state.mpcs.append(MPC(kind, tuple(fields[1:]), nodes, line.location))
 
 
 def read_rigid_body(card: Card, state: ParseState) -> None:
