@@ -50,7 +50,7 @@ from .constitutive import MaterialRegions
 from .errors import NonPositiveJacobianError
 from .fused import point_response_regions
 from .fused_points import inverse_transpose
-from .kernels import element_gradients
+from .kernels import add_point_stiffness, element_gradients
 from .space import Space
 from .terms import Blocks, Contribution, Term
 
@@ -72,8 +72,13 @@ def fbar_deformation(F: np.ndarray, dx: np.ndarray) -> tuple[np.ndarray, np.ndar
 def fbar_element_response(F, Pbar, A, dN, dx, tangent):
     """Element forces (nel, 3 nb) and, if ``tangent``, matrices (nel, 3 nb, 3 nb) (module docstring).
 
-    ``F``, ``Pbar``: (3, 3, nqp, nel); ``A[e, q, i, J, k, L]`` = dP/dF at F_bar (ignored unless ``tangent``);
-    ``dN``: (nel, nqp, nb, 3); ``dx``: (nel, nqp)."""
+    ``F``, ``Pbar``: (3, 3, nqp, nel); ``A[e, q, i, J, k, L]`` = dP/dF at F_bar (ignored unless ``tangent``), with
+    the major symmetry of a hyperelastic tangent; ``dN``: (nel, nqp, nb, 3); ``dx``: (nel, nqp).
+
+    With :math:`\\bar B = \\alpha(B + F\\otimes c)`: :math:`\\bar B^T\\bar P = \\alpha(p + s\\,c)` and
+    :math:`\\bar B^T\\bar{\\mathbb A}\\bar B = \\alpha^2\\big(B^T\\bar{\\mathbb A}B + u\\otimes c + c\\otimes u
+    + (F:\\bar{\\mathbb A}:F)\\,c\\otimes c\\big)`, :math:`u = B^T(\\bar{\\mathbb A}:F)`; the upper triangle is
+    summed and mirrored."""
     nel, nqp, nb, _ = dN.shape
     m = 3 * nb
     f = np.zeros((nel, m))
@@ -99,27 +104,23 @@ def fbar_element_response(F, Pbar, A, dN, dx, tangent):
             beta = dx[e, q] * J[q] / deformed
             for n in range(m):
                 g[n] += beta * GB[q, n]
-        Bbar = np.empty((9, m))
         c = np.empty(m)
         p = np.empty(m)
-        AB = np.empty((9, m))
+        x = np.empty(m)
+        AF = np.empty((3, 3))
+        Gw = np.empty((nb, 3, 3, 3))
+        Ke = np.zeros((m, m))
         S = 0.0
         for q in range(nqp):
             w = dx[e, q]
             alpha = (theta / J[q]) ** (1.0 / 3.0)
+            wa = w * alpha
             s = 0.0
             for i in range(3):
                 for jj in range(3):
                     s += Pbar[i, jj, q, e] * F[i, jj, q, e]
             for n in range(m):
                 c[n] = (g[n] - GB[q, n]) / 3.0
-            for i in range(3):
-                for jj in range(3):
-                    r = 3 * i + jj
-                    for n in range(m):
-                        Bbar[r, n] = alpha * F[i, jj, q, e] * c[n]
-                    for a in range(nb):
-                        Bbar[r, 3 * a + i] += alpha * dN[e, q, a, jj]
             for a in range(nb):
                 for k in range(3):
                     acc = 0.0
@@ -127,43 +128,50 @@ def fbar_element_response(F, Pbar, A, dN, dx, tangent):
                         acc += Pbar[k, L, q, e] * dN[e, q, a, L]
                     p[3 * a + k] = acc
             for n in range(m):
-                acc = 0.0
-                for r in range(9):
-                    acc += Bbar[r, n] * Pbar[r // 3, r % 3, q, e]
-                f[e, n] += w * acc
+                f[e, n] += wa * (p[n] + s * c[n])
             if not tangent:
                 continue
-            for r in range(9):
-                for n in range(m):
+            FAF = 0.0
+            for i in range(3):
+                for jj in range(3):
                     acc = 0.0
-                    for r2 in range(9):
-                        acc += A[e, q, r // 3, r % 3, r2 // 3, r2 % 3] * Bbar[r2, n]
-                    AB[r, n] = acc
-            geometric = w * alpha * s / 3.0
+                    for k in range(3):
+                        for L in range(3):
+                            acc += A[e, q, i, jj, k, L] * F[k, L, q, e]
+                    AF[i, jj] = acc
+                    FAF += F[i, jj, q, e] * acc
+            wa2 = wa * alpha
+            for a in range(nb):  # x = w alpha^2 u + w alpha p
+                for i in range(3):
+                    acc = 0.0
+                    for jj in range(3):
+                        acc += dN[e, q, a, jj] * AF[i, jj]
+                    x[3 * a + i] = wa2 * acc + wa * p[3 * a + i]
+            add_point_stiffness(Ke, dN[e, q], A[e, q], wa2, Gw)
+            geometric = wa * s / 3.0
             S += geometric
+            cc = wa2 * FAF + wa * s
             for n1 in range(m):
                 a1, i1 = n1 // 3, n1 % 3
-                for n2 in range(m):
+                c1, x1 = c[n1], x[n1]
+                for n2 in range(n1, m):
                     a2, i2 = n2 // 3, n2 % 3
-                    acc = 0.0
-                    for r in range(9):
-                        acc += Bbar[r, n1] * AB[r, n2]
-                    acc += alpha * (c[n1] * p[n2] + p[n1] * c[n2] + s * c[n1] * c[n2])
                     # B^T T B [(a1,i1),(a2,i2)] = (G:B)[a1, i2] (G:B)[a2, i1]
-                    BTB = GB[q, 3 * a1 + i2] * GB[q, 3 * a2 + i1]
-                    K[e, n1, n2] += w * acc + geometric * BTB
+                    Ke[n1, n2] += (c1 * x[n2] + x1 * c[n2] + cc * c1 * c[n2]
+                                   + geometric * GB[q, 3 * a1 + i2] * GB[q, 3 * a2 + i1])
         if tangent:  # S d2 ln(theta)/du2
-
             for q in range(nqp):
-                beta = dx[e, q] * J[q] / deformed
+                Sbeta = S * dx[e, q] * J[q] / deformed
                 for n1 in range(m):
                     a1, i1 = n1 // 3, n1 % 3
-                    for n2 in range(m):
+                    for n2 in range(n1, m):
                         a2, i2 = n2 // 3, n2 % 3
-                        K[e, n1, n2] += S * beta * (GB[q, n1] * GB[q, n2] - GB[q, 3 * a1 + i2] * GB[q, 3 * a2 + i1])
+                        Ke[n1, n2] += Sbeta * (GB[q, n1] * GB[q, n2] - GB[q, 3 * a1 + i2] * GB[q, 3 * a2 + i1])
             for n1 in range(m):
-                for n2 in range(m):
-                    K[e, n1, n2] -= S * g[n1] * g[n2]
+                for n2 in range(n1, m):
+                    v = Ke[n1, n2] - S * g[n1] * g[n2]
+                    K[e, n1, n2] = v
+                    K[e, n2, n1] = v
     return f, K
 
 
