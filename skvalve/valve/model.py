@@ -26,8 +26,9 @@ r"""A whole-valve model for the implicit solver, built from an Abaqus input (Tex
 
 The solver's load factor is the **step time** (0 to the step's time period): ``solve(problem,
 steps=times)``. Mesh vertices are numbered chordae-only nodes first, then the leaflet nodes, because
-scikit-fem counts ``max(cells) + 1`` vertices. Only one step is modelled at a time (``step=``); later
-steps (clip capture and closure) and contact are the closure's business (issue 11).
+scikit-fem counts ``max(cells) + 1`` vertices. Only one step is modelled at a time (``step=``); contact is the
+closure's business (issue 11). Inputs with parts the model cannot represent (the clip repair's rigid arms,
+connectors, bonded contact, further steps) are refused with their file lines (:mod:`.support`).
 """
 
 from __future__ import annotations
@@ -53,6 +54,7 @@ from ..materials.uniaxial import OgdenUniaxial, TensionOnly
 from .chordae import CollapsedChordae, collapse_chains
 from .extrude import extrude_shell, hex_corner_jacobians
 from .links import LINK_FACTOR, Links, link_constraints, link_nodes
+from .support import check_supported
 
 __all__ = ["ValveModel", "NodalCondition", "PressureLoad", "Chordae", "valve_model"]
 
@@ -248,10 +250,16 @@ def _chord_law(abaqus: AbaqusModel, name: str) -> OgdenUniaxial:
     return OgdenUniaxial(tuple(data[0:2 * n:2]), tuple(data[1:2 * n:2]))
 
 
-def valve_model(abaqus: AbaqusModel, layers: int = 4, step: int = 0, link_factor: float = LINK_FACTOR) -> ValveModel:
+def valve_model(abaqus: AbaqusModel, layers: int = 4, step: int = 0, link_factor: float = LINK_FACTOR,
+                partial: bool = False) -> ValveModel:
     """Build the :class:`ValveModel` of step ``step`` of ``abaqus`` (shells extruded into ``layers`` hexes; LINK
-    MPCs with ``link_factor`` times the stiffest chord's axial rigidity)."""
-    notes: list[str] = []
+    MPCs with ``link_factor`` times the stiffest chord's axial rigidity).
+
+    Raises :class:`~skvalve.valve.support.UnsupportedInputError` naming the keywords and file lines the model
+    cannot represent (rigid bodies, connectors, rigid-surface or bonded contact, rotations, further steps: the
+    1.0 clip repair); ``partial=True`` builds step ``step`` alone if it uses none of them itself.
+    """
+    notes: list[str] = check_supported(abaqus, step, partial)
     elem_type = np.empty(abaqus.n_elements, dtype=object)
     elem_conn: dict[int, np.ndarray] = {}
     for block in abaqus.element_blocks:
