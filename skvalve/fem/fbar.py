@@ -77,8 +77,9 @@ def fbar_element_response(F, Pbar, A, dN, dx, tangent):
 
     With :math:`\\bar B = \\alpha(B + F\\otimes c)`: :math:`\\bar B^T\\bar P = \\alpha(p + s\\,c)` and
     :math:`\\bar B^T\\bar{\\mathbb A}\\bar B = \\alpha^2\\big(B^T\\bar{\\mathbb A}B + u\\otimes c + c\\otimes u
-    + (F:\\bar{\\mathbb A}:F)\\,c\\otimes c\\big)`, :math:`u = B^T(\\bar{\\mathbb A}:F)`; the upper triangle is
-    summed and mirrored."""
+    + (F:\\bar{\\mathbb A}:F)\\,c\\otimes c\\big)`, :math:`u = B^T(\\bar{\\mathbb A}:F)`; the rank-one terms of
+    all points and the :math:`B^T T B` terms (a weighted Gram matrix of :math:`G:B`) are summed after the point
+    loop, on the upper triangle, and mirrored."""
     nel, nqp, nb, _ = dN.shape
     m = 3 * nb
     f = np.zeros((nel, m))
@@ -104,9 +105,10 @@ def fbar_element_response(F, Pbar, A, dN, dx, tangent):
             beta = dx[e, q] * J[q] / deformed
             for n in range(m):
                 g[n] += beta * GB[q, n]
-        c = np.empty(m)
+        c = np.empty((nqp, m))
+        y = np.empty((nqp, m))  # K += c_q (x) y_q + y_q (x) c_q
         p = np.empty(m)
-        x = np.empty(m)
+        geometric = np.empty(nqp)
         AF = np.empty((3, 3))
         Gw = np.empty((nb, 3, 3, 3))
         Ke = np.zeros((m, m))
@@ -120,7 +122,7 @@ def fbar_element_response(F, Pbar, A, dN, dx, tangent):
                 for jj in range(3):
                     s += Pbar[i, jj, q, e] * F[i, jj, q, e]
             for n in range(m):
-                c[n] = (g[n] - GB[q, n]) / 3.0
+                c[q, n] = (g[n] - GB[q, n]) / 3.0
             for a in range(nb):
                 for k in range(3):
                     acc = 0.0
@@ -128,7 +130,7 @@ def fbar_element_response(F, Pbar, A, dN, dx, tangent):
                         acc += Pbar[k, L, q, e] * dN[e, q, a, L]
                     p[3 * a + k] = acc
             for n in range(m):
-                f[e, n] += wa * (p[n] + s * c[n])
+                f[e, n] += wa * (p[n] + s * c[q, n])
             if not tangent:
                 continue
             FAF = 0.0
@@ -141,37 +143,42 @@ def fbar_element_response(F, Pbar, A, dN, dx, tangent):
                     AF[i, jj] = acc
                     FAF += F[i, jj, q, e] * acc
             wa2 = wa * alpha
-            for a in range(nb):  # x = w alpha^2 u + w alpha p
+            half = 0.5 * (wa2 * FAF + wa * s)
+            for a in range(nb):  # y = w alpha^2 u + w alpha p + (w alpha^2 F:A:F + w alpha s) c / 2
                 for i in range(3):
                     acc = 0.0
                     for jj in range(3):
                         acc += dN[e, q, a, jj] * AF[i, jj]
-                    x[3 * a + i] = wa2 * acc + wa * p[3 * a + i]
+                    n = 3 * a + i
+                    y[q, n] = wa2 * acc + wa * p[n] + half * c[q, n]
             add_point_stiffness(Ke, dN[e, q], A[e, q], wa2, Gw)
-            geometric = wa * s / 3.0
-            S += geometric
-            cc = wa2 * FAF + wa * s
+            geometric[q] = wa * s / 3.0
+            S += geometric[q]
+        if not tangent:
+            continue
+        # T[n, n'] = sum_q (w alpha s/3 - S beta)_q (G:B)_q[n] (G:B)_q[n']; S d2 ln(theta)/du2 holds the rest
+        T = np.zeros((m, m))
+        for q in range(nqp):
+            Sbeta = S * dx[e, q] * J[q] / deformed
             for n1 in range(m):
-                a1, i1 = n1 // 3, n1 % 3
-                c1, x1 = c[n1], x[n1]
+                c1, y1, gb1 = c[q, n1], y[q, n1], Sbeta * GB[q, n1]
                 for n2 in range(n1, m):
-                    a2, i2 = n2 // 3, n2 % 3
-                    # B^T T B [(a1,i1),(a2,i2)] = (G:B)[a1, i2] (G:B)[a2, i1]
-                    Ke[n1, n2] += (c1 * x[n2] + x1 * c[n2] + cc * c1 * c[n2]
-                                   + geometric * GB[q, 3 * a1 + i2] * GB[q, 3 * a2 + i1])
-        if tangent:  # S d2 ln(theta)/du2
-            for q in range(nqp):
-                Sbeta = S * dx[e, q] * J[q] / deformed
-                for n1 in range(m):
-                    a1, i1 = n1 // 3, n1 % 3
-                    for n2 in range(n1, m):
-                        a2, i2 = n2 // 3, n2 % 3
-                        Ke[n1, n2] += Sbeta * (GB[q, n1] * GB[q, n2] - GB[q, 3 * a1 + i2] * GB[q, 3 * a2 + i1])
-            for n1 in range(m):
-                for n2 in range(n1, m):
-                    v = Ke[n1, n2] - S * g[n1] * g[n2]
-                    K[e, n1, n2] = v
-                    K[e, n2, n1] = v
+                    Ke[n1, n2] += c1 * y[q, n2] + y1 * c[q, n2] + gb1 * GB[q, n2]
+                t1 = (geometric[q] - Sbeta) * GB[q, n1]
+                for n2 in range(m):
+                    T[n1, n2] += t1 * GB[q, n2]
+        for a1 in range(nb):
+            for i1 in range(3):
+                n1 = 3 * a1 + i1
+                for a2 in range(a1, nb):
+                    for i2 in range(3):
+                        n2 = 3 * a2 + i2
+                        if n2 < n1:
+                            continue
+                        # B^T T B [(a1,i1),(a2,i2)] = (G:B)[a1, i2] (G:B)[a2, i1]
+                        v = Ke[n1, n2] + T[3 * a1 + i2, 3 * a2 + i1] - S * g[n1] * g[n2]
+                        K[e, n1, n2] = v
+                        K[e, n2, n1] = v
     return f, K
 
 
