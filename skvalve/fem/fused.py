@@ -106,21 +106,20 @@ def _law_point(kind, F, D, aux, has_direction, q, e, Fq, H, Dq, aq, Vq, S, Pq, A
 
 
 @njit(parallel=True, cache=True, error_model="numpy")
-def _point_kernel(kind, F, D, aux, has_direction, tangent):
-    """P[i, J, q, e] and, if ``tangent``, A[e, q, i, J, k, L] = dP_iJ/dF_kL at every point."""
+def _point_kernel(kind, F, D, aux, has_direction, tangent, elements, P, A_all):
+    """At every point (q, e) of F: P[i, J, q, t] and, if ``tangent``, A_all[t, q, i, J, k, L] = dP_iJ/dF_kL,
+    t = elements[e] (a region written into the arrays of all elements)."""
     nqp, nel = F.shape[2], F.shape[3]
-    P = np.empty((3, 3, nqp, nel))
-    A_all = np.empty((nel if tangent else 0, nqp, 3, 3, 3, 3))
     for e in prange(nel):
+        t = elements[e]
         Fq, H, S, Pq, A, Dq, Vq, aq, G3, M3, B3, c3 = _point_scratch(D.shape[0])
         for q in range(nqp):
             _law_point(kind, F, D, aux, has_direction, q, e, Fq, H, Dq, aq, Vq, S, Pq, A, tangent, G3, M3, B3, c3)
             for i in range(3):
                 for j in range(3):
-                    P[i, j, q, e] = Pq[i, j]
+                    P[i, j, q, t] = Pq[i, j]
             if tangent:
-                A_all[e, q] = A
-    return P, A_all
+                A_all[t, q] = A
 
 
 @njit(parallel=True, cache=True, error_model="numpy")
@@ -261,12 +260,23 @@ class FusedLaw:
         """``P`` (3,3,nqp,nel) and ``A[e, q, i, J, k, L]`` :math:`= \\partial P_{iJ}/\\partial F_{kL}` (None unless
         ``tangent``) at every point of ``F`` (3,3,nqp,nel): the layout of
         :meth:`~skvalve.fem.constitutive.MaterialRegions.evaluate`, one compiled loop."""
+        nqp, nel = F.shape[2:] if np.ndim(F) == 4 else (0, 0)
+        P = np.empty((3, 3, nqp, nel))
+        A = np.empty((nel, nqp, 3, 3, 3, 3)) if tangent else None
+        self.point_response_into(F, np.arange(nel), P, A)
+        return P, A
+
+    def point_response_into(self, F: np.ndarray, elements: np.ndarray, P: np.ndarray, A: np.ndarray | None) -> None:
+        """:meth:`point_response` of ``F`` (3,3,nqp,n) written to ``P[:, :, :, elements]`` and ``A[elements]``
+        (``A`` None: no tangent); ``P`` and ``A`` C-contiguous arrays of all elements."""
         F = np.ascontiguousarray(F, dtype=float)
         if F.ndim != 4 or F.shape[:2] != (3, 3):
             raise ValueError(f"F must have shape (3, 3, nqp, nel); got {F.shape}")
         D, aux, has_direction = self._derivatives(F)
-        P, A = _point_kernel(self.kind, F, np.ascontiguousarray(D), aux, has_direction, bool(tangent))
-        return P, (A if tangent else None)
+        tangent = A is not None
+        _point_kernel(self.kind, F, np.ascontiguousarray(D), aux, has_direction, tangent,
+                      np.ascontiguousarray(elements, dtype=np.int64), P,
+                      A if tangent else np.empty((0, F.shape[2], 3, 3, 3, 3)))
 
 
 def fused_response(law) -> FusedLaw | None:
@@ -307,16 +317,12 @@ def point_response_regions(materials: MaterialRegions, F: np.ndarray,
     fused = _fused_laws(materials)
     if fused is None:
         return None
-    if _single_region(materials):
-        return fused[0].point_response(F, tangent)
     nqp, nel = F.shape[2], F.shape[3]
     P = np.empty((3, 3, nqp, nel))
     A = np.empty((nel, nqp, 3, 3, 3, 3)) if tangent else None
     for region, evaluate in zip(materials.regions, fused, strict=True):
-        Pr, Ar = evaluate.point_response(F[:, :, :, region.elements], tangent)
-        P[:, :, :, region.elements] = Pr
-        if tangent:
-            A[region.elements] = Ar
+        elements = np.arange(nel)[region.elements]
+        evaluate.point_response_into(F[:, :, :, elements], elements, P, A)
     return P, A
 
 
