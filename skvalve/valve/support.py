@@ -7,7 +7,7 @@ every such keyword with its file line. ``partial=True`` builds the chosen step a
 uses none of them; model-level parts it does not touch (e.g. parked clip arms) become notes.
 
 The Texas TriValve 1.0 clip repair (``Clipping_QuasiStatic.inp``): what a run needs
-----------------------------------------------------------------------------------
+-----------------------------------------------------------------------------------
 The input adds four rigid clip arms (parts ``Clip-1-1``, ``Clip-1-2``, ``Clip-2-1``, ``Clip-2-2``: 3544
 ``R3D4`` facets each, ``*Rigid Body`` on reference nodes 1-4) and runs three explicit steps:
 
