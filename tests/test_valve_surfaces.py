@@ -17,16 +17,21 @@ from skvalve.valve.surfaces import CONTACT_SURFACES_1_0, contact_surface, contac
 NX, NY, THICKNESS, LAYERS = 3, 2, 0.2, 2
 
 
-def shell_deck(face: str = "SPOS", contact: bool = True) -> str:
-    """NX x NY unit S4R quads in the plane z = 0 (normals +z), one element-face surface ``Skin``."""
+def shell_deck(face: str = "SPOS", contact: bool = True, second_plate_at: float | None = None) -> str:
+    """NX x NY unit S4R quads in the plane z = 0 (normals +z), one element-face surface ``Skin``; optionally a copy
+    of the plate at height ``second_plate_at`` (in the same surface)."""
     lines = ["*Part, name=P", "*Node"]
-    for j in range(NY + 1):
-        lines += [f"{1 + j * (NX + 1) + i}, {float(i)}, {float(j)}, 0.0" for i in range(NX + 1)]
+    heights = [0.0] if second_plate_at is None else [0.0, second_plate_at]
+    per_plate = (NX + 1) * (NY + 1)
+    for k, z in enumerate(heights):
+        for j in range(NY + 1):
+            lines += [f"{1 + k * per_plate + j * (NX + 1) + i}, {float(i)}, {float(j)}, {z!r}" for i in range(NX + 1)]
     lines.append("*Element, type=S4R, elset=Leaf")
-    for j in range(NY):
-        for i in range(NX):
-            a = 1 + j * (NX + 1) + i
-            lines.append(f"{1 + j * NX + i}, {a}, {a + 1}, {a + NX + 2}, {a + NX + 1}")
+    for k in range(len(heights)):
+        for j in range(NY):
+            for i in range(NX):
+                a = 1 + k * per_plate + j * (NX + 1) + i
+                lines.append(f"{1 + k * NX * NY + j * NX + i}, {a}, {a + 1}, {a + NX + 2}, {a + NX + 1}")
     lines += ["*Shell Section, elset=Leaf, material=M", f"{THICKNESS}, 5", "*End Part",
               "*Assembly, name=A", "*Instance, name=I, part=P", "*End Instance",
               "*Surface, type=ELEMENT, name=Skin", f"I.Leaf, {face}", "*End Assembly",
@@ -101,6 +106,40 @@ def test_the_two_skins_are_not_contact_within_the_thinnest_stack(tmp_path):
     assert deep.active_pairs(u).size > 0
     shallow = SurfaceContact(space, surface, 1.0, max_penetration=0.25 * thinnest_stack(model, abaqus), exclude_rings=1)
     assert shallow.active_pairs(u).size == 0
+
+
+@pytest.mark.parametrize("overlap", [0.01, -0.01])
+def test_two_stacked_shell_plates_touch_on_their_facing_skins(tmp_path, overlap):
+    """A second plate at height h - overlap: its SNEG skin dips ``overlap`` into the first plate's SPOS skin. The
+    written surface is SPOS only; the double-sided mapping finds the contact, every pair joins the two facing skins
+    with gap -overlap, and the resultant on the upper plate is penalty x overlap x (the tributary areas of both
+    skins, two passes); a positive gap (overlap < 0) gives no pair."""
+    abaqus, model = _build(tmp_path, second_plate_at=THICKNESS - overlap)
+    surface = contact_surface(abaqus, model)
+    space = Space(model.mesh)
+    penalty = 2.0
+    contact = SurfaceContact(space, surface, penalty, max_penetration=0.25 * thinnest_stack(model, abaqus),
+                             smoothing=0.0)
+    u = np.zeros(space.n_dofs)
+    pairs = contact.active_pairs(u)
+    if overlap < 0:
+        assert pairs.size == 0
+        return
+    X = model.mesh.p.T
+    lower_top, upper_bottom = THICKNESS / 2, THICKNESS / 2 - overlap
+    on = {z: np.flatnonzero(np.isclose(X[:, 2], z)) for z in (lower_top, upper_bottom)}
+    assert np.array_equal(np.unique(pairs.node), np.union1d(on[lower_top], on[upper_bottom]))
+    triangle_z = X[surface.triangles[pairs.triangle]][:, :, 2]
+    node_z = X[pairs.node, 2]
+    assert np.all(np.isclose(triangle_z, np.where(np.isclose(node_z, lower_top), upper_bottom, lower_top)[:, None]))
+    np.testing.assert_allclose(pairs.gap, -overlap, rtol=1e-12)
+    force = contact.assemble(u, 0.0, False, None).internal[: space.n_u].reshape(-1, 3)
+    upper = np.unique(model.mesh.t[:, model.element_source >= NX * NY])  # hexes of the second plate's shells
+    areas = np.zeros(X.shape[0])
+    areas[surface.nodes] = surface.nodal_area
+    expected = penalty * overlap * (areas[on[lower_top]].sum() + areas[on[upper_bottom]].sum())
+    assert -force[upper, 2].sum() == pytest.approx(expected, rel=1e-12)  # pushes the upper plate up
+    assert force[:, 2].sum() == pytest.approx(0.0, abs=1e-14)
 
 
 def test_inputs_without_contact_have_no_default_surfaces(tmp_path):
