@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["Amplitude", "SmoothStep", "Tabular", "smooth_step_polynomial"]
+__all__ = ["Amplitude", "SmoothStep", "Tabular", "GeometricRamp", "smooth_step_polynomial"]
 
 
 def smooth_step_polynomial(xi: ArrayLike) -> np.ndarray:
@@ -93,3 +93,31 @@ class Tabular(Amplitude):
 
     def _shape(self, xi: np.ndarray) -> np.ndarray:
         return xi
+
+
+@dataclass(frozen=True)
+class GeometricRamp:
+    r"""A continuation factor from ``start`` to 1 between ``t_start`` and ``t_end``, smooth and geometric:
+
+    .. math::
+
+        s(t) = s_0^{\,1 - S(\xi)}, \qquad \xi = \frac{t - t_\text{start}}{t_\text{end} - t_\text{start}},
+
+    with :math:`S` the smooth-step polynomial (:func:`smooth_step_polynomial`), so :math:`\ln s` moves from
+    :math:`\ln s_0` to 0 without jumps in its first two derivatives (equal ratios per equal step near the
+    middle); :math:`s = s_0` before ``t_start`` and 1 after ``t_end``.
+    """
+
+    start: float
+    t_start: float
+    t_end: float
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.start) and self.start > 0.0):
+            raise ValueError(f"GeometricRamp: start must be positive and finite; got {self.start!r}")
+        if not (np.isfinite(self.t_start) and np.isfinite(self.t_end) and self.t_end > self.t_start):
+            raise ValueError(f"GeometricRamp: need t_start < t_end; got {self.t_start!r}, {self.t_end!r}")
+
+    def __call__(self, t: float) -> float:
+        xi = (t - self.t_start) / (self.t_end - self.t_start)
+        return float(self.start ** (1.0 - float(smooth_step_polynomial(xi))))

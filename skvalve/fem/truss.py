@@ -23,7 +23,7 @@ tension resists transverse motion of its ends by :math:`N/l`). ``K`` is symmetri
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -128,11 +128,14 @@ class Truss(Term):
     slack_stretch : per-bar force-free stretch (<= 1) of tension-only laws, e.g. the reference distance over
         the rest length of a collapsed chain, so that a curved chain starts stress-free.
     name : shown in error messages.
+    stiffness_scale : optional :math:`s(t) > 0` multiplying every bar's force and tangent (the stored energy
+        :math:`s W`): a continuation parameter, e.g. cables that start soft and stiffen to their law
+        (:class:`~skvalve.fem.amplitudes.GeometricRamp`); ``None`` is :math:`s = 1`.
     """
 
     def __init__(self, space: Space, nodes: np.ndarray, area, laws, law_index: np.ndarray | None = None,
                  rest_length: np.ndarray | None = None, slack_stretch: np.ndarray | None = None,
-                 name: str = "truss") -> None:
+                 name: str = "truss", stiffness_scale: Callable[[float], float] | None = None) -> None:
         if space.dim != 3:
             raise ValueError(f"{name}: trusses need a 3D displacement space; got dimension {space.dim}")
         nodes = np.asarray(nodes, dtype=np.int64)
@@ -144,6 +147,7 @@ class Truss(Term):
         if same.size:
             raise ValueError(f"{name}: bar(s) {same[:10].tolist()} join a node to itself")
         self.name = name
+        self.stiffness_scale = stiffness_scale
         self.space = space
         self.nodes = nodes
         self.n_bars = nodes.shape[0]
@@ -185,5 +189,13 @@ class Truss(Term):
             state = self.response(u, tangent)
         except ValueError as err:
             raise ValueError(f"{err} (load step {step}, load factor {t})") from err
-        internal = np.bincount(self.dofs.ravel(), state.forces.ravel(), minlength=self.space.n_dofs)
-        return Contribution(internal=internal, blocks=[Blocks(self.dofs, state.matrices)])
+        forces, matrices = state.forces, state.matrices
+        if self.stiffness_scale is not None:
+            scale = float(self.stiffness_scale(t))
+            if not (np.isfinite(scale) and scale > 0.0):
+                raise ValueError(f"{self.name}: stiffness_scale must be positive and finite; got {scale!r} at load "
+                                 f"factor {t} (load step {step})")
+            forces = scale * forces
+            matrices = None if matrices is None else scale * matrices
+        internal = np.bincount(self.dofs.ravel(), forces.ravel(), minlength=self.space.n_dofs)
+        return Contribution(internal=internal, blocks=[Blocks(self.dofs, matrices)])

@@ -26,17 +26,19 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fem.contact import ContactSurface, SurfaceContact
+from ..fem.amplitudes import GeometricRamp
+from ..fem.contact import SurfaceContact
 from ..fem.damping import DampingSchedule, ViscousDamping, undamped_residual
 from ..fem.newton import StepEvent, solve
 from ..fem.problem import Problem
-from ..io.abaqus import HEX_FACE_NODES, AbaqusModel, read_model, trivalve_input
+from ..fem.truss import Truss
+from ..io.abaqus import AbaqusModel, read_model, trivalve_input
 from .model import ValveModel, valve_model
+from .surfaces import contact_surface, thinnest_stack
 
 __all__ = ["ClosureOptions", "ClosureSetup", "ClosureRun", "closure_setup", "contact_surface", "load_factors",
            "run_closure"]
 
-CONTACT_SURFACES = ("LEAFLET_SURFACES_INNER", "LEAFLET_RIM_TIP")
 
 
 @dataclass
@@ -50,10 +52,15 @@ class ClosureOptions:
     end : last step time (1.5 = end-systole; less for a partial closure).
     rtol, atol : Newton tolerances: relative to reactions/loads, and an absolute floor (N) for the papillary
     stage, whose loads and reactions are nearly zero (pressure load at the end: about 8 N).
+    cable_softening, cable_stiffening : the chordae start with their law scaled by ``cable_softening`` and
+    stiffen geometrically to it over the step-time interval ``cable_stiffening``
+    (:class:`~skvalve.fem.amplitudes.GeometricRamp`); 1 switches the continuation off.
+    path_rtol, path_atol : looser tolerances for the steps while the damping acts (a pseudo-transient path,
+    not equilibria of the problem); the steps from ``damping_off`` on are solved to ``rtol, atol``.
     """
 
     penalty: float = 1.0
-    damping: float = 1e-4
+    damping: float = 1e-3
     damping_off: float = 1.25
     papillary_steps: int = 10
     pressure_steps: int = 20
@@ -63,6 +70,10 @@ class ClosureOptions:
     rtol: float = 1e-6
     atol: float = 1e-6
     solver: str | None = None
+    cable_softening: float = 1e-3
+    path_rtol: float = 1e-4
+    path_atol: float = 1e-5
+    cable_stiffening: tuple[float, float] = (0.4, 0.6)
 
 
 @dataclass
@@ -99,51 +110,6 @@ def load_factors(options: ClosureOptions) -> np.ndarray:
     return np.concatenate([first, np.linspace(0.5, options.end, options.pressure_steps + 1)[1:]])
 
 
-def _brick_connectivity(abaqus: AbaqusModel) -> tuple[dict[int, np.ndarray], dict[int, int]]:
-    """Global element index -> its 8 global node indices (bricks only), and -> its label (all elements)."""
-    conn, labels = {}, {}
-    for block in abaqus.element_blocks:
-        for index, label, row in zip(block.indices, block.labels, block.connectivity, strict=True):
-            labels[int(index)] = int(label)
-            if block.connectivity.shape[1] == 8:
-                conn[int(index)] = row
-    return conn, labels
-
-
-def contact_surface(abaqus: AbaqusModel, model: ValveModel, names=CONTACT_SURFACES) -> ContactSurface:
-    """The union of the named element-face surfaces as a :class:`ContactSurface` on the model's vertices.
-
-    Brick (C3D8/C3D8R) faces S1–S6 only; faces are oriented away from their element.
-    """
-    conn, labels = _brick_connectivity(abaqus)
-    vertex_of = np.full(abaqus.nodes.shape[0], -1, dtype=np.int64)
-    has_source = model.vertex_source >= 0
-    vertex_of[model.vertex_source[has_source]] = np.flatnonzero(has_source)
-    quads, inside = [], []
-    for name in names:
-        surface = abaqus.surface(name)
-        for group in surface.faces:
-            face = group.face.upper()
-            if face not in HEX_FACE_NODES:
-                raise ValueError(f"contact surface {name!r}: face {face} is not a brick face S1..S6 (shell models "
-                                 "are extruded by the model builder; their contact surfaces are not mapped yet)")
-            for element in group.elements:
-                row = conn.get(int(element))
-                if row is None:
-                    raise ValueError(f"contact surface {name!r}: element {labels.get(int(element), int(element))} "
-                                     "is not a brick")
-                vertices = vertex_of[row]
-                if np.any(vertices < 0):
-                    raise ValueError(f"contact surface {name!r}: element {labels.get(int(element), int(element))} "
-                                     "has nodes outside the model's mesh")
-                quads.append(vertices[list(HEX_FACE_NODES[face])])
-                inside.append(model.mesh.p[:, vertices].mean(axis=1))
-    quads_arr = np.array(quads, dtype=np.int64)
-    _, first = np.unique(np.sort(quads_arr, axis=1), axis=0, return_index=True)
-    first = np.sort(first)
-    return ContactSurface.from_quads(model.mesh.p.T, quads_arr[first], np.array(inside)[first])
-
-
 def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: AbaqusModel | None = None
                   ) -> ClosureSetup:
     """Read the input (``path``; default the shipped diseased 1.0 valve) and build problem, contact, damping."""
@@ -156,8 +122,17 @@ def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: Abaq
         abaqus = read_model(path)
     model = valve_model(abaqus)
     problem = model.problem()
+    if options.cable_softening != 1.0:
+        ramp = GeometricRamp(options.cable_softening, *options.cable_stiffening)
+        for term in problem.terms:
+            if isinstance(term, Truss):
+                term.stiffness_scale = ramp
     surface = contact_surface(abaqus, model)
-    contact = problem.add_term(SurfaceContact(problem.space, surface, options.penalty))
+    # extruded shells: the two skins of one stack face each other a thickness apart; a search depth of a
+    # quarter of the thinnest stack keeps them from pairing (bricks: the contact term's default depth)
+    thinnest = thinnest_stack(model, abaqus)
+    depth = None if thinnest is None else 0.25 * thinnest
+    contact = problem.add_term(SurfaceContact(problem.space, surface, options.penalty, max_penetration=depth))
     damping = None
     if options.damping > 0.0:
         damping = problem.add_term(ViscousDamping(problem.space, DampingSchedule(options.damping,
@@ -187,10 +162,21 @@ def run_closure(setup: ClosureSetup, options: ClosureOptions | None = None, call
         run.u = event.u
 
     start = time.perf_counter()
+    factors = load_factors(options)
+    factors = factors[factors > t0 * (1 + 1e-12)]
+    damped_until = options.damping_off if setup.damping is not None else 0.0
+    stages = [(factors[factors < damped_until], options.path_rtol, options.path_atol),
+              (factors[factors >= damped_until], options.rtol, options.atol)]
+    stage_callbacks = [record, *callbacks]
     try:
-        solve(setup.problem, load_factors(options), rtol=options.rtol, atol=options.atol, max_iter=options.max_iter,
-              max_cutbacks=options.max_cutbacks, solver=options.solver, progress=progress, verbose=verbose,
-              u0=u0, t0=t0, callbacks=[record, *callbacks])
+        for steps, rtol, atol in stages:
+            if steps.size == 0:
+                continue
+            solve(setup.problem, steps, rtol=rtol, atol=atol, max_iter=options.max_iter,
+                  max_cutbacks=options.max_cutbacks, solver=options.solver, progress=progress, verbose=verbose,
+                  u0=u0, t0=t0, callbacks=stage_callbacks)
+            u0, t0 = run.u, run.load_factors[-1]
+            stage_callbacks = [_AfterStart(callback) for callback in (record, *callbacks)]
     except Exception as err:  # noqa: BLE001 - a failed closure is a result to report, with its last state
         run.error = f"{type(err).__name__}: {err}"
     finally:
@@ -199,6 +185,17 @@ def run_closure(setup: ClosureSetup, options: ClosureOptions | None = None, call
     if run.u is not None:
         run.undamped_residual = undamped_residual(setup.problem, run.u, run.load_factors[-1])
     return run
+
+
+class _AfterStart:
+    """A callback that skips the start state of a solve (the last state of the previous stage, already seen)."""
+
+    def __init__(self, callback) -> None:
+        self.callback = callback
+
+    def __call__(self, event: StepEvent) -> None:
+        if event.step > 0:
+            self.callback(event)
 
 
 def write_log(run: ClosureRun, path: Path) -> None:
