@@ -19,8 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-from skvalve.io.abaqus import trivalve_input
+from skvalve.io.abaqus import read_model, trivalve_input
 from skvalve.valve.closure import ClosureOptions, closure_setup, run_closure, write_log
+from skvalve.valve.model import valve_model
 
 
 class LastState:
@@ -38,23 +39,30 @@ class LastState:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("trivalve_closure_out"))
-    parser.add_argument("--end", type=float, default=1.5, help="last step time (1.5 = end-systole)")
+    parser.add_argument("--end", type=float, default=None, help="last step time (default: the input's step time)")
     parser.add_argument("--verbose", action="store_true", help="one line per Newton iteration")
     parser.add_argument("--resume", action="store_true", help="start from --out/last_state.npz")
     parser.add_argument("--damping", type=float, default=ClosureOptions.damping, help="damping coefficient c0")
+    parser.add_argument("--input", type=Path, default=None,
+                        help="another TriValve input (.inp; default: the 1.0 diseased valve, $SKVALVE_TRIVALVE)")
     args = parser.parse_args()
-    if trivalve_input() is None:
+    path = trivalve_input() if args.input is None else args.input
+    if path is None or not Path(path).exists():
         print("Texas TriValve input not found: set $SKVALVE_TRIVALVE (Mathur et al. 2022, CC BY-NC-SA 4.0)")
         return 2
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(message)s")
     args.out.mkdir(parents=True, exist_ok=True)
-    options = ClosureOptions(end=args.end, damping=args.damping)
+    abaqus = read_model(path)
     u0, t0 = None, 0.0
     if args.resume:
         state = np.load(args.out / "last_state.npz")
         u0, t0 = state["u"], float(state["t"])
         print(f"resuming from step time {t0:.5g}", flush=True)
-    setup = closure_setup(options=options)
+    model = valve_model(abaqus)
+    overrides = {"damping": args.damping} if args.end is None else {"damping": args.damping, "end": args.end}
+    options = ClosureOptions.for_model(model, **overrides)
+    print(f"input {Path(path).name}: {options}", flush=True)
+    setup = closure_setup(options=options, abaqus=abaqus, model=model)
     print("model:", setup.model.counts(), "contact faces:", setup.contact.surface.quads.shape[0], flush=True)
     if args.verbose:
         search = setup.contact.active_pairs

@@ -135,3 +135,24 @@ def test_a_resumed_closure_ends_where_an_uninterrupted_one_does():
     resumed = run_closure(_blocks_setup(0.15), options, progress=False, u0=first.u, t0=first.load_factors[-1])
     assert resumed.load_factors == pytest.approx([0.5, 1.0, 1.5])
     np.testing.assert_allclose(resumed.u, whole.u, atol=1e-9)
+
+
+def test_options_fitted_to_the_staging_of_an_input():
+    """1.0 inputs: papillary motion over 0-0.5, pressure over 0.5-1.5; the 1.1 healthy input ramps everything over
+    0-1 (no papillary stage, no soft start of the cables)."""
+    from types import SimpleNamespace
+
+    from skvalve.fem.amplitudes import SmoothStep
+
+    def stub(start, end):
+        pressure = SimpleNamespace(amplitude=SmoothStep((start, end), (0.0, 1.0), "Amp-1"))
+        return SimpleNamespace(pressures=[pressure], end_time=end)
+
+    staged = ClosureOptions.for_model(stub(0.5, 1.5), pressure_steps=4)
+    assert (staged.end, staged.pressure_start, staged.damping_off) == (1.5, 0.5, 1.25)
+    assert staged.cable_stiffening == (0.4, 0.6) and staged.cable_softening == ClosureOptions.cable_softening
+    together = ClosureOptions.for_model(stub(0.0, 1.0), pressure_steps=4)
+    fitted = (together.end, together.pressure_start, together.damping_off, together.cable_softening)
+    assert fitted == (1.0, 0.0, 0.75, 1.0)
+    np.testing.assert_allclose(load_factors(together), [0.25, 0.5, 0.75, 1.0])
+    assert ClosureOptions.for_model(stub(0.0, 1.0), damping=0.0).damping == 0.0  # overrides win

@@ -48,8 +48,11 @@ class ClosureOptions:
     penalty : contact penalty (MPa/mm): overlap ~ pressure / (2 penalty) (two-pass).
     damping : :math:`c_0` of the damping schedule (MPa·s/mm² per unit lumped volume) and ``damping_off``,
     the step time from which it is zero.
-    papillary_steps, pressure_steps : nominal load steps over 0–0.5 and 0.5–``end``.
+    papillary_steps, pressure_steps : nominal load steps over 0–``pressure_start`` and ``pressure_start``–``end``.
+    pressure_start : step time at which the pressure amplitude starts (0.5 in the 1.0 inputs: papillary motion
+    first; 0 where everything ramps together, as in the 1.1 healthy input).
     end : last step time (1.5 = end-systole; less for a partial closure).
+    :meth:`for_model` derives ``end``, ``pressure_start``, ``damping_off`` and ``cable_stiffening`` from an input.
     rtol, atol : Newton tolerances: relative to reactions/loads, and an absolute floor (N) for the papillary
     stage, whose loads and reactions are nearly zero (pressure load at the end: about 8 N).
     cable_softening, cable_stiffening : the chordae start with their law scaled by ``cable_softening`` and
@@ -74,6 +77,24 @@ class ClosureOptions:
     path_rtol: float = 1e-4
     path_atol: float = 1e-5
     cable_stiffening: tuple[float, float] = (0.4, 0.6)
+    pressure_start: float = 0.5
+
+    @classmethod
+    def for_model(cls, model: ValveModel, **overrides) -> ClosureOptions:
+        """Options fitted to a model's step: ``end`` its step time, ``pressure_start`` the start of its pressure
+        amplitude, damping off at three quarters of the pressure stage, cables stiffening over
+        0.8–1.2 x ``pressure_start`` (no soft start when pressure and papillary motion ramp together)."""
+        starts = [float(p.amplitude.times[0]) for p in model.pressures if p.amplitude is not None]
+        pressure_start = min(starts) if starts else 0.0
+        end = float(model.end_time)
+        fitted = {"end": end, "pressure_start": pressure_start,
+                  "damping_off": pressure_start + 0.75 * (end - pressure_start)}
+        if pressure_start > 0.0:
+            fitted["cable_stiffening"] = (0.8 * pressure_start, min(1.2 * pressure_start, end))
+        else:
+            fitted["cable_softening"] = 1.0
+        fitted.update(overrides)
+        return cls(**fitted)
 
 
 @dataclass
@@ -103,16 +124,19 @@ class ClosureRun:
 
 
 def load_factors(options: ClosureOptions) -> np.ndarray:
-    """Nominal step times: ``papillary_steps`` over (0, 0.5], ``pressure_steps`` over (0.5, end]."""
-    first = np.linspace(0.0, min(0.5, options.end), options.papillary_steps + 1)[1:]
-    if options.end <= 0.5:
+    """Nominal step times: ``papillary_steps`` over (0, ``pressure_start``], ``pressure_steps`` over
+    (``pressure_start``, ``end``] (all ``pressure_steps`` when the pressure starts at 0)."""
+    split = options.pressure_start
+    first = np.linspace(0.0, min(split, options.end), options.papillary_steps + 1)[1:] if split > 0 else np.empty(0)
+    if options.end <= split:
         return first
-    return np.concatenate([first, np.linspace(0.5, options.end, options.pressure_steps + 1)[1:]])
+    return np.concatenate([first, np.linspace(split, options.end, options.pressure_steps + 1)[1:]])
 
 
-def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: AbaqusModel | None = None
-                  ) -> ClosureSetup:
-    """Read the input (``path``; default the shipped diseased 1.0 valve) and build problem, contact, damping."""
+def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: AbaqusModel | None = None,
+                  model: ValveModel | None = None) -> ClosureSetup:
+    """Read the input (``path``; default the shipped diseased 1.0 valve) unless ``abaqus`` (and ``model``) are given,
+    and build problem, contact, damping."""
     options = options or ClosureOptions()
     if abaqus is None:
         path = trivalve_input() if path is None else path
@@ -120,7 +144,7 @@ def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: Abaq
             raise FileNotFoundError("Texas TriValve input not found: set $SKVALVE_TRIVALVE to the .inp file or its "
                                     "folder (model files of Mathur et al. 2022, CC BY-NC-SA 4.0)")
         abaqus = read_model(path)
-    model = valve_model(abaqus)
+    model = valve_model(abaqus) if model is None else model
     problem = model.problem()
     if options.cable_softening != 1.0:
         ramp = GeometricRamp(options.cable_softening, *options.cable_stiffening)
