@@ -10,7 +10,9 @@ from matplotlib.collections import PolyCollection
 
 from skvalve.io.abaqus import trivalve_input
 from skvalve.papers.mathur2022 import figures
-from skvalve.valve.closure import ClosureOptions, closure_setup
+from skvalve.papers.mathur2022 import reproduce as reproduce_module
+from skvalve.papers.table import Written
+from skvalve.valve.closure import ClosureOptions, ClosureRun, closure_setup
 from skvalve.valve.outputs import closure_measures, max_principal_cauchy
 
 DISEASED = trivalve_input()
@@ -149,3 +151,20 @@ def test_unrolled_map_keeps_arc_length_and_height():
     # the face crosses the seam at angle pi: its corners past -pi are drawn past +pi, keeping it whole
     np.testing.assert_allclose(strip[:, 0], 10 * np.array([0.1, 0.5, 3.1, 2 * np.pi - 3.1]))
     np.testing.assert_allclose(strip[:, 1], [-1.0, -2.0, -3.0, -4.0])
+
+
+def test_reproduce_full_writes_the_figures_of_the_last_state(setup, tmp_path, monkeypatch):
+    """The --full path with the closure replaced by a run that stopped at the open configuration."""
+    module = reproduce_module
+
+    def stopped(setup, options, callbacks=(), progress=True):
+        return ClosureRun(load_factors=[0.0], iterations=[0], contact_pairs=[0],
+                          u=np.zeros(setup.problem.space.n_dofs), error="stopped for the test")
+
+    monkeypatch.setattr(module, "closure_setup", lambda path, options: setup)
+    monkeypatch.setattr(module, "run_closure", stopped)
+    items = list(module.reproduce(tmp_path, full=True))
+    names = ("mathur2022_atrial_stress.png", "mathur2022_coaptation.png", "mathur2022_orifice.png")
+    for name in names:
+        assert _png_width(tmp_path / name) >= 600
+    assert [item.path.name for item in items if isinstance(item, Written)] == list(names)

@@ -10,7 +10,8 @@ closure takes far longer than a default run (``benchmarks/trivalve_closure.py``)
 
 ``full=True``: the implicit closure from the open configuration to end-systole
 (:func:`skvalve.valve.closure.run_closure`) and all Table 2 (orifice, leaflet, coaptation area) and
-Table 3 (centre stresses) rows of the diseased column, with a VTU series in ``out``. When the closure stops
+Table 3 (centre stresses) rows of the diseased column, with a VTU series and the figures of
+:mod:`.figures` in ``out``. When the closure stops
 early, the rows are those of the last converged state, marked with the step time reached.
 
 The model files (Mathur et al. 2022, CC BY-NC-SA 4.0) are never copied; without them the run ends with a
@@ -28,8 +29,9 @@ import numpy as np
 from ...io.abaqus import trivalve_input
 from ...valve.closure import ClosureOptions, closure_setup, run_closure, write_log
 from ...valve.outputs import ClosureWriter, closure_measures
-from ..table import Reason, Row, Stage
+from ..table import Reason, Row, Stage, Written
 from .data import CREDIT, TABLE2_AREAS, TABLE3_CENTRE_STRESS
+from .figures import write_figures
 
 __all__ = ["DESCRIPTION", "reproduce", "EXIT_NO_INPUT"]
 
@@ -49,7 +51,7 @@ def _require_input() -> Path:
     return path
 
 
-def reproduce(out: Path | None = None, full: bool = False) -> Iterator[Row | Stage]:
+def reproduce(out: Path | None = None, full: bool = False) -> Iterator[Row | Stage | Written]:
     """Yield the Table 2–3 rows (module docstring); exits with code 2 when the shipped input is absent."""
     path = _require_input()
     options = ClosureOptions()
@@ -77,6 +79,8 @@ def reproduce(out: Path | None = None, full: bool = False) -> Iterator[Row | Sta
     complete = run.error is None and reached >= options.end
     state = "end-systole" if complete else f"stopped at step time {reached:.3g} of 1.5 ({run.error})"
     yield Stage(f"closure {state}; undamped residual (norm, relative) {run.undamped_residual}")
+    if out is not None and run.u is not None:
+        yield from (Written(path) for path in write_figures(setup, run.u, reached, out))
     measures = closure_measures(setup, run.u, reached)
     reason = None if complete else Reason.MODEL_DIFFERENCE
     suffix = "" if complete else f"; closure incomplete: {state}"
