@@ -39,6 +39,14 @@ def _displacement(setup, mapping) -> np.ndarray:
     return u
 
 
+def _widening(X: np.ndarray) -> np.ndarray:
+    """A smooth, non-uniform map: horizontal stretch growing from 0 at the lowest node to about 10 %."""
+    centre = X.mean(axis=0)
+    x = X.copy()
+    x[:, :2] = centre[:2] + (1.0 + 0.004 * (X[:, 2:] - X[:, 2].min())) * (X[:, :2] - centre[:2])
+    return x
+
+
 def _png_width(path) -> int:
     data = path.read_bytes()
     assert data[:8] == b"\x89PNG\r\n\x1a\n" and data[12:16] == b"IHDR"
@@ -91,13 +99,7 @@ def test_the_view_is_from_the_atrium_and_not_mirrored(setup):
 
 
 def test_stress_colours_are_the_owning_hexes_stresses_in_kpa_over_their_range(setup, tmp_path):
-    def squeeze(X):
-        centre = X.mean(axis=0)
-        x = X.copy()
-        x[:, :2] = centre[:2] + (1.0 + 0.004 * (X[:, 2:] - X[:, 2].min())) * (X[:, :2] - centre[:2])
-        return x
-
-    u = _displacement(setup, squeeze)
+    u = _displacement(setup, _widening)
     result = figures.atrial_view_stress(setup, u, 1.0, tmp_path / "stress.png")
     mesh = setup.model.mesh
     # each drawn face is a face of the hex whose colour it carries, and only boundary faces are drawn once each
@@ -168,3 +170,15 @@ def test_reproduce_full_writes_the_figures_of_the_last_state(setup, tmp_path, mo
     for name in names:
         assert _png_width(tmp_path / name) >= 600
     assert [item.path.name for item in items if isinstance(item, Written)] == list(names)
+
+
+def test_stress_limits_clip_the_colour_range_and_extend_the_bar(setup, tmp_path):
+    u = _displacement(setup, _widening)
+    default = figures.atrial_view_stress(setup, u, 0.0, tmp_path / "default.png")
+    low, high = np.percentile(default.stress_kpa, [5, 95])
+    result = figures.atrial_view_stress(setup, u, 0.0, tmp_path / "limits.png", limits=(low, high))
+    (faces,) = _polys(result.figure)
+    (free,) = _polys(default.figure)
+    assert faces.get_clim() == (low, high)
+    assert faces.colorbar.extend == "both" and free.colorbar.extend == "neither"
+    np.testing.assert_array_equal(faces.get_array(), free.get_array())  # the values are kept, only the map clips

@@ -200,8 +200,13 @@ def _caption(fig: Figure, t: float, credit: str) -> None:
 
 
 def atrial_view_stress(setup: ClosureSetup, u: np.ndarray, t: float, path, credit: str = CREDIT,
-                       cmap: str = "viridis") -> StressFigure:
-    """The valve seen from the atrium, outer hex faces coloured by maximum principal Cauchy stress (kPa)."""
+                       cmap: str = "viridis", limits: tuple[float, float] | None = None) -> StressFigure:
+    """The valve seen from the atrium, outer hex faces coloured by maximum principal Cauchy stress (kPa).
+
+    ``limits``: colour range (kPa), default the smallest and largest stress shown; values outside it take the
+    end colours (the colour bar is then extended), e.g. to keep the stress risers at the chordae insertions
+    from flattening the rest of the map.
+    """
     quads, owners = outer_faces(setup)
     x = _current(setup, u)
     ring = annulus_loop(setup, u)
@@ -212,9 +217,12 @@ def atrial_view_stress(setup: ClosureSetup, u: np.ndarray, t: float, path, credi
         fig = _new_figure()
         ax = fig.add_subplot()
         faces = PolyCollection(polygons[order], array=stress, cmap=cmap, edgecolors="face", linewidths=0.2)
-        faces.set_clim(float(stress.min()), float(stress.max()))
+        low, high = (float(stress.min()), float(stress.max())) if limits is None else limits
+        faces.set_clim(low, high)
         ax.add_collection(faces)
-        fig.colorbar(faces, ax=ax, label="max principal Cauchy stress (kPa)", shrink=0.85)
+        extend = {(False, False): "neither", (True, False): "min", (False, True): "max", (True, True): "both"}[
+            (bool(stress.min() < low), bool(stress.max() > high))]
+        fig.colorbar(faces, ax=ax, label="max principal Cauchy stress (kPa)", shrink=0.85, extend=extend)
         _frame(ax, projection, ring, "Valve seen from the atrium: maximum principal Cauchy stress")
         _caption(fig, t, credit)
         save_figure(fig, path)
@@ -283,7 +291,9 @@ def coaptation_map(setup: ClosureSetup, u: np.ndarray, t: float, path, pressure:
         else:
             top.text(0.5, 0.5, "no contact", transform=top.transAxes, ha="center", va="center")
         _frame(top, projection, ring, f"Coaptation: contact pressure, coaptation area {area:.1f} mm²")
-        bottom.axhline(0.0, color="black", lw=1.0)
+        annulus = unrolled(reference, reference_ring[:, None], radius)[:, 0]
+        annulus = annulus[np.argsort(annulus[:, 0], kind="stable")]
+        bottom.plot(*annulus.T, color="black", lw=1.2)
         bottom.set_aspect("equal")
         bottom.autoscale_view()
         bottom.set_xlabel("arc length about the annulus axis (mm), on the open valve (end-diastole, as Fig. 7b)")
