@@ -11,7 +11,7 @@ closure takes far longer than a default run (``benchmarks/trivalve_closure.py``)
 ``full=True``: the implicit closure from the open configuration to end-systole
 (:func:`skvalve.valve.closure.run_closure`) and all Table 2 (orifice, leaflet, coaptation area) and
 Table 3 (centre stresses) rows of the diseased column, with a VTU series and the figures of
-:mod:`.figures` in ``out``. When the closure stops
+:mod:`skvalve.papers.mathur2022.figures` in ``out``. When the closure stops
 early, the rows are those of the last converged state, marked with the step time reached.
 
 The model files (Mathur et al. 2022, CC BY-NC-SA 4.0) are never copied; without them the run ends with a
