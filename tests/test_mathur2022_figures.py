@@ -82,6 +82,7 @@ def test_orifice_polygon_area_is_the_table2_orifice_and_the_view_turns_with_the_
     assert result.area == pytest.approx(expected, rel=1e-9)
     title = result.figure.axes[0].get_title()
     assert float(re.search(r"area ([0-9.]+) mm", title).group(1)) == pytest.approx(expected, abs=0.05)
+    assert "Mathur et al. 2022" in result.figure.get_suptitle() and "CC BY-NC-SA 4.0" in result.figure.get_suptitle()
     # the viewer's side follows the valve: a rigid motion carries the normal along (a 180 degree turn flips it)
     reference = figures.atrial_projection(setup, np.zeros_like(u))
     turned = figures.atrial_projection(setup, u)

@@ -196,7 +196,7 @@ def _new_figure() -> Figure:
 
 
 def _caption(fig: Figure, t: float, credit: str) -> None:
-    fig.suptitle(f"model: {credit}; step time t = {t:.3g} (1.5: end-systole)", fontsize=9)
+    fig.suptitle(f"model: {credit}; step time t = {t:.4g}", fontsize=9)
 
 
 def atrial_view_stress(setup: ClosureSetup, u: np.ndarray, t: float, path, credit: str = CREDIT,
@@ -346,10 +346,13 @@ def orifice_outline(setup: ClosureSetup, u: np.ndarray, t: float, path, surface:
     return OrificeFigure(Path(path), fig, polygon, area)
 
 
-def write_figures(setup: ClosureSetup, u: np.ndarray, t: float, out, stem: str = "mathur2022") -> list[Path]:
-    """The three figures of a state as ``<out>/<stem>_{atrial_stress,coaptation,orifice}.png``."""
+def write_figures(setup: ClosureSetup, u: np.ndarray, t: float, out, stem: str = "mathur2022",
+                  credit: str = CREDIT) -> list[Path]:
+    """The three figures of a state as ``<out>/<stem>_{atrial_stress,coaptation,orifice}.png``.
+
+    ``credit``: the model's source and licence, printed on each figure (default the 1.0 inputs')."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    return [atrial_view_stress(setup, u, t, out / f"{stem}_atrial_stress.png").path,
-            coaptation_map(setup, u, t, out / f"{stem}_coaptation.png").path,
-            orifice_outline(setup, u, t, out / f"{stem}_orifice.png").path]
+    return [atrial_view_stress(setup, u, t, out / f"{stem}_atrial_stress.png", credit=credit).path,
+            coaptation_map(setup, u, t, out / f"{stem}_coaptation.png", credit=credit).path,
+            orifice_outline(setup, u, t, out / f"{stem}_orifice.png", credit=credit).path]
