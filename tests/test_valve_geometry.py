@@ -1,4 +1,5 @@
-"""Valve geometry measures against closed forms, and on the Texas TriValve 1.0 diseased input.
+"""Valve geometry measures against closed forms, on the Texas TriValve 1.0 diseased input, and the closure
+measures of the 1.1 shell inputs against the inputs' own shells measured independently here.
 
 Closed forms: inscribed n-gon areas of a circle and an ellipse (n/2 R^2 sin(2 pi/n), n/2 a b sin(2 pi/n)),
 rigidly moved and saddle-warped loops, planar quads in a tilted plane (shoelace in the plane), the
@@ -16,6 +17,7 @@ from scipy.spatial.transform import Rotation
 
 from skvalve.io.abaqus import read_model, trivalve_inputs
 from skvalve.papers.mathur2022.data import LEAFLET_THICKNESS, TABLE2_AREAS
+from skvalve.valve.closure import closure_setup
 from skvalve.valve.geometry import (
     annulus_nodes,
     boundary_loops,
@@ -28,6 +30,7 @@ from skvalve.valve.geometry import (
     surface_area,
     valve_areas,
 )
+from skvalve.valve.outputs import abaqus_positions, closure_measures
 
 ROTATION = Rotation.from_rotvec([0.3, -1.1, 0.7]).as_matrix()
 SHIFT = np.array([4.0, -2.0, 9.0])
@@ -238,23 +241,28 @@ def test_leaflet_surfaces_of_a_brick_band(tmp_path, layers):
             assert areas.orifice[which] == pytest.approx(scale**2 * 0.5 * n * r**2 * np.sin(2 * np.pi / n), rel=1e-12)
 
 
-def test_leaflet_surfaces_of_a_shell_band(tmp_path):
-    """S4R band: the mid surface is the shells', SPOS (outward here) the ventricular side at +t/2."""
+@pytest.mark.parametrize("triangles", [False, True])
+def test_leaflet_surfaces_of_a_shell_band(tmp_path, triangles):
+    """S4R band: the mid surface is the shells', SPOS (outward here) the ventricular side at +t/2. The same band
+    of S3 triangles (each rectangle split in two): the same mid-surface and orifice areas."""
     radius, thickness, height, n, rows = 10.0, 0.65, 6.0, 24, 4
     lines = ["*Node"]
     for k in range(rows + 1):
         for j in range(n):
             x, y = (float(v) for v in radius * np.array([np.cos(2 * np.pi * j / n), np.sin(2 * np.pi * j / n)]))
             lines.append(f"{1 + k * n + j}, {x!r}, {y!r}, {height * k / rows!r}")
-    lines.append("*Element, type=S4R")
+    lines.append("*Element, type=S3" if triangles else "*Element, type=S4R")
     names = ("Anterior", "Posterior", "Septal")
     sectors = {name: [] for name in names}
     for k in range(rows):
         for j in range(n):
             label = 1 + k * n + j
             corners = [1 + k * n + j, 1 + k * n + (j + 1) % n, 1 + (k + 1) * n + (j + 1) % n, 1 + (k + 1) * n + j]
-            lines.append(", ".join(str(v) for v in [label, *corners]))
-            sectors[names[3 * j // n]].append(label)
+            pieces = [(label, corners[:3]), (label + rows * n, [corners[0], *corners[2:]])] if triangles else \
+                [(label, corners)]
+            for number, nodes in pieces:
+                lines.append(", ".join(str(v) for v in [number, *nodes]))
+                sectors[names[3 * j // n]].append(number)
     for name, labels in sectors.items():
         lines += [f"*Elset, elset={name}_Leaflet_Elements", *(f"{v}," for v in labels),
                   f"*Shell Section, elset={name}_Leaflet_Elements, material=M", f"{thickness}, 5"]
@@ -265,7 +273,134 @@ def test_leaflet_surfaces_of_a_shell_band(tmp_path):
     path.write_text("\n".join(lines) + "\n")
     logging.getLogger("skvalve.io.abaqus.reader").setLevel(logging.ERROR)
     model = read_model(path)
-    areas = valve_areas(leaflet_surfaces(model), model.nodes, annulus_nodes(model))
-    for which, r in (("ventricular", radius + thickness / 2), ("mid", radius), ("atrial", radius - thickness / 2)):
+    surfaces = leaflet_surfaces(model)
+    for name, surface in surfaces.items():  # each face knows its shell element
+        labels = np.concatenate([b.labels for b in model.element_blocks])[surface.elements]
+        assert sorted(labels.tolist()) == sorted(sectors[name])
+    areas = valve_areas(surfaces, model.nodes, annulus_nodes(model))
+    # triangles: the offset surfaces move along unequally weighted nodal normals, only the mid surface is exact
+    checked = [("mid", radius)] if triangles else \
+        [("ventricular", radius + thickness / 2), ("mid", radius), ("atrial", radius - thickness / 2)]
+    for which, r in checked:
         assert areas.total(which) == pytest.approx(height * n * 2 * r * np.sin(np.pi / n), rel=1e-12)
         assert areas.orifice[which] == pytest.approx(0.5 * n * r**2 * np.sin(2 * np.pi / n), rel=1e-12)
+
+
+# ----------------------------------------------------------------------------------------------------
+# Texas TriValve 1.1 (Mathur et al. 2022 data, CC BY-NC-SA 4.0): shell midsurfaces extruded into hexes.
+# closure_measures against the input's own shell connectivity, re-read and measured here independently.
+
+SHELL_INPUTS = [key for key in ("1.1-healthy", "1.1-diseased") if key in INPUTS]
+GAUSS_POINTS, GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(3)
+
+
+@pytest.fixture(scope="module", params=SHELL_INPUTS or [pytest.param(None, marks=pytest.mark.skip(
+    reason="Texas TriValve 1.1 inputs not present"))])
+def shell_valve(request):
+    """(closure setup, independently read input, its leaflet shell quads by leaflet) of one 1.1 input."""
+    logging.getLogger("skvalve.io.abaqus.reader").setLevel(logging.ERROR)
+    path = INPUTS[request.param]
+    model = read_model(path)
+    rows = {int(e): row for block in model.element_blocks
+            for e, row in zip(block.indices, block.connectivity, strict=True)}
+    quads = {}
+    for leaflet in ("Anterior", "Posterior", "Septal"):
+        (elements,) = [s.indices for key, s in model.element_sets.items()
+                       if key.endswith(f".{leaflet.upper()}_LEAFLET_ELEMENTS")]
+        quads[leaflet] = np.array([rows[int(e)] for e in elements])
+    return closure_setup(path), model, quads
+
+
+def _bilinear_tangent_cross(corners):
+    """x_xi x x_eta of the bilinear quads x = a + b xi + c eta + d xi eta at the 3 x 3 Gauss points: (m, 9, 3)."""
+    x0, x1, x2, x3 = (corners[:, k] for k in range(4))
+    b, c, d = (-x0 + x1 + x2 - x3) / 4, (-x0 - x1 + x2 + x3) / 4, (x0 - x1 + x2 - x3) / 4
+    return np.stack([np.cross(b + d * eta, c + d * xi) for xi in GAUSS_POINTS for eta in GAUSS_POINTS], axis=1)
+
+
+def _quad_area(cross, cofactor=None):
+    """Areas sum_gauss w |cof(F) (X_xi x X_eta)| of quads (reference tangents, linear map F)."""
+    weights = np.outer(GAUSS_WEIGHTS, GAUSS_WEIGHTS).ravel()
+    cofactor = np.eye(3) if cofactor is None else cofactor
+    return (np.linalg.norm(cross @ cofactor.T, axis=2) * weights).sum(axis=1)
+
+
+def _annulus_loop(model, quads):
+    """The Annular_Nodes set ordered by angle about its centroid in its best-fit plane; checked to be a loop of
+    free edges of the leaflet shells. Returns (loop node indices, unit normal of the plane)."""
+    (annulus,) = [s.indices for key, s in model.node_sets.items() if key.endswith(".ANNULAR_NODES")]
+    points = model.nodes[annulus]
+    centred = points - points.mean(axis=0)
+    _, _, vt = np.linalg.svd(centred)
+    loop = annulus[np.argsort(np.arctan2(centred @ vt[1], centred @ vt[0]))]
+    all_quads = np.concatenate(list(quads.values()))
+    edges = np.sort(np.stack([all_quads, np.roll(all_quads, -1, axis=1)], axis=-1).reshape(-1, 2), axis=1)
+    keys, counts = np.unique(edges, axis=0, return_counts=True)
+    free = {tuple(k) for k in keys[counts == 1].tolist()}
+    assert all(tuple(sorted(pair)) in free for pair in zip(loop.tolist(), np.roll(loop, -1).tolist(), strict=True))
+    return loop, vt[2]
+
+
+def _shoelace_area(points, normal):
+    """|n . 1/2 sum x_i x x_{i+1}| of a closed polygon."""
+    return abs(0.5 * np.cross(points, np.roll(points, -1, axis=0)).sum(axis=0) @ normal)
+
+
+def test_trivalve_shell_reference_measures(shell_valve):
+    """u = 0: the leaflet areas are the shells' bilinear areas, the orifice the annulus polygon's, no stress."""
+    setup, model, quads = shell_valve
+    u = np.zeros(setup.problem.space.n_dofs)
+    assert np.array_equal(abaqus_positions(setup, u), model.nodes)
+    measures = closure_measures(setup, u, 0.0)
+    total = 0.0
+    for leaflet, faces in quads.items():
+        corners = model.nodes[faces]
+        area = _quad_area(_bilinear_tangent_cross(corners)).sum()
+        assert measures.per_leaflet_area[leaflet]["mid"] == pytest.approx(area, rel=1e-12)
+        # the flat-quad vector area 1/2 |d1 x d2| is a lower bound, within the quads' small warp
+        flat = 0.5 * np.linalg.norm(np.cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1]), axis=1)
+        assert flat.sum() <= area <= flat.sum() * (1 + 1e-3)
+        total += area
+    assert measures.leaflet_area["mid"] == pytest.approx(total, rel=1e-12)
+    loop, normal = _annulus_loop(model, quads)
+    assert measures.orifice["mid"] == pytest.approx(_shoelace_area(model.nodes[loop], normal), rel=1e-12)
+    assert measures.centre_stress == {"Anterior": 0.0, "Posterior": 0.0, "Septal": 0.0}
+
+
+def _lee_sacks_max_principal(F, c0, D, c1, c2):
+    """Homogeneous closed form of c0/2 (I1b-3) + c1/2 (exp(c2 (I1b-3)^2) - 1) + (J-1)^2/D:
+    sigma = 2/J dW/dI1b dev(b_bar) + 2 (J-1)/D I, largest eigenvalue."""
+    J = np.linalg.det(F)
+    b_bar = J ** (-2.0 / 3.0) * F @ F.T
+    x = np.trace(b_bar) - 3.0
+    w1 = 0.5 * c0 + c1 * c2 * x * np.exp(c2 * x * x)
+    sigma = 2.0 / J * w1 * (b_bar - np.trace(b_bar) / 3.0 * np.eye(3)) + 2.0 * (J - 1.0) / D * np.eye(3)
+    return np.linalg.eigvalsh(sigma)[-1]
+
+
+def test_trivalve_shell_measures_under_a_uniform_stretch(shell_valve):
+    """u = (F - I) X on every vertex, F = diag(1.1, 1, 1): shell nodes move to F X, areas map by cof F, the
+    centre stress is the homogeneous Lee-Sacks closed form with the input's parameters."""
+    setup, model, quads = shell_valve
+    F = np.diag([1.1, 1.0, 1.0])
+    cofactor = np.linalg.det(F) * np.linalg.inv(F).T
+    X = setup.model.mesh.p.T
+    u = np.zeros(setup.problem.space.n_dofs)
+    u[: setup.problem.space.n_u] = (X @ (F - np.eye(3)).T).ravel()
+    shell_nodes = np.unique(np.concatenate(list(quads.values())))
+    x = abaqus_positions(setup, u)
+    np.testing.assert_allclose(x[shell_nodes], model.nodes[shell_nodes] @ F.T, rtol=0, atol=1e-12 * np.abs(X).max())
+    measures = closure_measures(setup, u, 0.0)
+    for leaflet, faces in quads.items():
+        area = _quad_area(_bilinear_tangent_cross(model.nodes[faces]), cofactor).sum()
+        assert measures.per_leaflet_area[leaflet]["mid"] == pytest.approx(area, rel=1e-12)
+    loop, _ = _annulus_loop(model, quads)
+    reference = model.nodes[loop]
+    vector_area = cofactor @ (0.5 * np.cross(reference, np.roll(reference, -1, axis=0)).sum(axis=0))
+    stretched = reference @ F.T
+    normal = np.linalg.svd(stretched - stretched.mean(axis=0))[2][2]
+    assert measures.orifice["mid"] == pytest.approx(abs(vector_area @ normal), rel=1e-12)
+    for leaflet, value in measures.centre_stress.items():
+        (section,) = [s for s in model.sections if s.elset.upper().endswith(f".{leaflet.upper()}_LEAFLET_ELEMENTS")]
+        c0, D, c1, c2 = model.material(section.material).option("anisotropic hyperelastic").data
+        assert value == pytest.approx(_lee_sacks_max_principal(F, c0, D, c1, c2), rel=1e-9)

@@ -67,10 +67,12 @@ def loop_area(points: np.ndarray, loop: np.ndarray | None = None) -> float:
 def boundary_loops(faces: np.ndarray) -> list[np.ndarray]:
     """Ordered node loops of the boundary of a surface mesh (edges used by exactly one face), longest first.
 
-    ``faces``: (m, 3) triangles or (m, 4) quads of node indices, consistently or not oriented.
+    ``faces``: (m, 3) triangles or (m, 4) quads of node indices, consistently or not oriented; a triangle
+    written as a quad with a repeated corner (``[a, b, c, c]``) contributes its three edges.
     """
     faces = np.asarray(faces)
     edges = np.stack([faces, np.roll(faces, -1, axis=1)], axis=-1).reshape(-1, 2)
+    edges = edges[edges[:, 0] != edges[:, 1]]
     keys, counts = np.unique(np.sort(edges, axis=1), axis=0, return_counts=True)
     neighbours: dict[int, list[int]] = defaultdict(list)
     for a, b in keys[counts == 1].tolist():
@@ -189,7 +191,8 @@ class LeafletSurfaces:
     and ``mid_upper`` coincide for an even number of layers; for an odd number the mid surface is the
     average of the middle brick's bottom and top faces). Shells (1.1): ``mid`` is the element surface,
     ventricular/atrial are offset by ``±thickness/2`` along the averaged nodal normals (the pressure acts
-    on SPOS, the ventricular side).
+    on SPOS, the ventricular side); ``elements`` gives the input element index of each mid face, triangles
+    (S3) are quads with a repeated last corner (their bilinear area is the triangle's).
     """
 
     name: str
@@ -198,6 +201,7 @@ class LeafletSurfaces:
     ventricular: np.ndarray | None = None
     atrial: np.ndarray | None = None
     thickness: float | None = None
+    elements: np.ndarray | None = None
 
     def surface(self, which: str, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(points, faces) of surface ``which`` in configuration ``x`` (all node coordinates)."""
@@ -246,6 +250,21 @@ def _leaflet_elements(model: AbaqusModel, leaflet: str) -> np.ndarray:
     return hits[0].indices
 
 
+def _shell_faces(model: AbaqusModel, elements: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Quads (triangles with the last corner repeated) of the shell ``elements`` and their element indices."""
+    faces, owners = [], []
+    for block in model.element_blocks:
+        chosen = np.isin(block.indices, elements)
+        if not chosen.any():
+            continue
+        if block.connectivity.shape[1] not in (3, 4):
+            raise ValueError(f"{model.path}: shell elements of type {block.element_type} (not S3/S4) in a leaflet")
+        connectivity = block.connectivity[chosen]
+        faces.append(connectivity if connectivity.shape[1] == 4 else connectivity[:, [0, 1, 2, 2]])
+        owners.append(np.asarray(block.indices)[chosen])
+    return np.concatenate(faces), np.concatenate(owners)
+
+
 def leaflet_surfaces(model: AbaqusModel) -> dict[str, LeafletSurfaces]:
     """Ventricular, mid and atrial faces of each leaflet of a Texas TriValve model (bricks or shells)."""
     pressured = {int(e) for step in model.steps for load in step.distributed_loads
@@ -256,9 +275,8 @@ def leaflet_surfaces(model: AbaqusModel) -> dict[str, LeafletSurfaces]:
         elements = _leaflet_elements(model, leaflet)
         sections = [s for s in model.sections if s.kind == "shell" and np.isin(elements, s.elements).all()]
         if sections:
-            faces = np.concatenate([b.connectivity[np.isin(b.indices, elements)] for b in model.element_blocks
-                                    if b.connectivity.shape[1] == 4])
-            result[leaflet] = LeafletSurfaces(leaflet, faces, faces, thickness=sections[0].thickness)
+            faces, owners = _shell_faces(model, elements)
+            result[leaflet] = LeafletSurfaces(leaflet, faces, faces, thickness=sections[0].thickness, elements=owners)
             continue
         bottom = np.array(sorted(pressured.intersection(elements.tolist())), dtype=np.int64)
         if len(bottom) == 0 or np.any(conn[bottom, 0] < 0):

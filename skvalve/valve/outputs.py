@@ -4,11 +4,20 @@ Measures of a state :math:`u` of a :class:`~skvalve.valve.closure.ClosureSetup` 
 
 * orifice and leaflet areas of :func:`skvalve.valve.geometry.valve_areas` (ventricular, mid and atrial
   surfaces), the leaflet centre regions chosen once on the reference configuration;
+* shell inputs (Texas TriValve 1.1, extruded into stacks of ``layers`` hexes by :mod:`.extrude`): the leaflet
+  surface is the shell midsurface, the input's own shell faces, and an input shell node sits at the mean of
+  the two model vertices of its through-thickness fibre at layers :math:`\lfloor n/2 \rfloor` and
+  :math:`\lceil n/2 \rceil`, i.e. on the middle node layer of the stack for an even :math:`n` (the default
+  :math:`n = 4`: the layer that carries the midsurface and the chordae attachments, at exactly the input
+  node in the reference configuration) and halfway between the two middle layers for an odd :math:`n`. The
+  ventricular/atrial surfaces of a shell input are the current midsurface offset by the reference
+  :math:`\pm h/2` (:class:`~skvalve.valve.geometry.LeafletSurfaces`), not the stack's skins;
 * coaptation area: the current area of the contact surface's faces with positive contact pressure
   (:meth:`~skvalve.fem.contact.SurfaceContact.contact_area`): both touching sides count, as Abaqus's CAREA of
   a self-contact surface does;
 * centre stress: the maximum principal Cauchy stress at the centres of the hexes that share a centre-region
-  face of the mid surface, averaged over them (the paper averages over the leaflet centres, Fig. 4d/e).
+  face of the mid surface, averaged over them (the paper averages over the leaflet centres, Fig. 4d/e); for
+  shells, all hexes of the stacks extruded from the centre region's shell elements.
 
 :class:`ClosureWriter` is a solver callback writing one VTU per converged step (hexes in VTK order and the
 chordae as lines) with displacement, leaflet id, nodal contact pressure and maximum principal Cauchy stress,
@@ -17,7 +26,8 @@ plus the ``.pvd`` collection, every file written under a temporary name and rena
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import weakref
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import meshio
@@ -26,32 +36,91 @@ import scipy.sparse as sp
 
 from ..fem.fields import element_centres
 from ..fem.newton import StepEvent
+from ..io.abaqus.elements import is_shell_like
 from ..io.files import replace_atomically
 from .closure import ClosureSetup
 from .geometry import annulus_nodes, leaflet_surfaces, valve_areas
 from .model import ABAQUS_TO_SKFEM_HEX
+from .surfaces import shell_stacks
 
-__all__ = ["ClosureMeasures", "closure_measures", "ClosureWriter", "abaqus_positions"]
+__all__ = ["ClosureMeasures", "closure_measures", "ClosureWriter", "abaqus_positions", "ShellMidsurface",
+           "shell_midsurface"]
 
 LEAFLETS = ("anterior", "posterior", "septal")
 
 
 @dataclass
 class ClosureMeasures:
-    """Table 2–3 quantities of one state (mm², MPa)."""
+    """Table 2–3 quantities of one state (mm², MPa).
+
+    ``orifice`` and ``leaflet_area`` (all leaflets) per surface; ``per_leaflet_area``: leaflet -> surface -> area.
+    """
 
     orifice: dict[str, float]
     leaflet_area: dict[str, float]
     coaptation_area: float
     centre_stress: dict[str, float]
+    per_leaflet_area: dict[str, dict[str, float]] = field(default_factory=dict)
+
+
+@dataclass
+class ShellMidsurface:
+    """Input shell nodes and the two model vertices (layers floor(n/2), ceil(n/2) of their fibre) they average."""
+
+    nodes: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+
+
+def shell_midsurface(setup: ClosureSetup) -> ShellMidsurface:
+    """The :class:`ShellMidsurface` of a setup's extruded shells (empty for bricks; module docstring).
+
+    Raises ``ValueError`` if the vertices found do not average to the input's shell nodes in the reference
+    configuration (a model not built by :func:`~skvalve.valve.model.valve_model`'s extrusion).
+    """
+    abaqus, model = setup.abaqus, setup.model
+    blocks = [b for b in abaqus.element_blocks if is_shell_like(b.element_type)]
+    stacks = shell_stacks(model) if blocks else {}
+    corners = model.mesh.t.T[:, np.argsort(ABAQUS_TO_SKFEM_HEX)]  # Abaqus C3D8 corner order
+    nodes, lower, upper = [], [], []
+    for block in blocks:
+        n = block.connectivity.shape[1]
+        for element, connectivity in zip(block.indices.tolist(), block.connectivity, strict=True):
+            stack = stacks.get(element)
+            if stack is None:
+                continue
+            # hex k of a stack spans node layers k (corners 1-4, in the shell's node order) and k + 1 (corners 5-8)
+            middle = corners[stack[len(stack) // 2]]
+            nodes.append(connectivity)
+            lower.append(middle[:n])
+            upper.append(middle[:n] if len(stack) % 2 == 0 else middle[4:4 + n])
+    if not nodes:
+        empty = np.zeros(0, dtype=np.int64)
+        return ShellMidsurface(empty, empty, empty)
+    found, first = np.unique(np.concatenate(nodes), return_index=True)
+    result = ShellMidsurface(found, np.concatenate(lower)[first], np.concatenate(upper)[first])
+    X = model.mesh.p.T
+    gap = np.linalg.norm(0.5 * (X[result.lower] + X[result.upper]) - abaqus.nodes[found], axis=1)
+    scale = max(float(np.ptp(abaqus.nodes[found], axis=0).max()), 1.0)
+    if gap.max() > 1e-9 * scale:
+        worst = int(np.argmax(gap))
+        raise ValueError(f"{abaqus.path}: shell node label {abaqus.node_labels[found[worst]]} is {gap[worst]:.3g} "
+                         "away from the middle of its extruded fibre (not an extrusion of the model builder)")
+    return result
 
 
 def abaqus_positions(setup: ClosureSetup, u: np.ndarray) -> np.ndarray:
-    """Current coordinates of all the input's nodes (nodes outside the model stay where they are)."""
+    """Current coordinates of all the input's nodes (nodes outside the model stay where they are).
+
+    Shell nodes follow the middle of their extruded fibre (:func:`shell_midsurface`).
+    """
     x = setup.abaqus.nodes.copy()
     source = setup.model.vertex_source
     has = source >= 0
-    x[source[has]] = setup.model.mesh.p.T[has] + u[: setup.problem.space.n_u].reshape(-1, 3)[has]
+    current = setup.model.mesh.p.T + u[: setup.problem.space.n_u].reshape(-1, 3)
+    x[source[has]] = current[has]
+    mid = _reference(setup).midsurface
+    x[mid.nodes] = 0.5 * (current[mid.lower] + current[mid.upper])
     return x
 
 
@@ -75,32 +144,57 @@ def _elements_with_faces(setup: ClosureSetup, faces: np.ndarray) -> np.ndarray:
 
 
 class _Reference:
-    """Surfaces, annulus and centre regions of the reference configuration, computed once per setup."""
+    """Shell midsurface map, surfaces, annulus and centre regions of the reference configuration, once per setup."""
 
     def __init__(self, setup: ClosureSetup) -> None:
+        self.midsurface = shell_midsurface(setup)
+        self._measured = False
+
+    def measure(self, setup: ClosureSetup) -> _Reference:
+        """Surfaces, annulus and centre regions (on first use: :func:`abaqus_positions` needs only the map)."""
+        if self._measured:
+            return self
         self.surfaces = leaflet_surfaces(setup.abaqus)
         self.annulus = annulus_nodes(setup.abaqus)
         areas = valve_areas(self.surfaces, setup.abaqus.nodes, self.annulus)
         self.centre_faces = areas.centre_faces
         self.centre_elements = {}
+        stacks = None
         for name, leaflet in self.surfaces.items():
-            faces = leaflet.mid_lower[areas.centre_faces[name]]
-            self.centre_elements[name] = _elements_with_faces(setup, faces)
+            if leaflet.thickness is not None:  # shells: every hex of the centre elements' stacks
+                stacks = shell_stacks(setup.model) if stacks is None else stacks
+                owners = leaflet.elements[areas.centre_faces[name]].tolist()
+                self.centre_elements[name] = np.unique(np.concatenate([stacks[e] for e in owners]))
+            else:
+                faces = leaflet.mid_lower[areas.centre_faces[name]]
+                self.centre_elements[name] = _elements_with_faces(setup, faces)
+        self._measured = True
+        return self
 
 
-_REFERENCES: dict[int, _Reference] = {}
+_REFERENCES: dict[int, tuple[weakref.ref, _Reference]] = {}
+
+
+def _reference(setup: ClosureSetup) -> _Reference:
+    """The cached :class:`_Reference` of ``setup`` (keyed by identity, dropped when the setup is collected)."""
+    key = id(setup)
+    cached = _REFERENCES.get(key)
+    if cached is None or cached[0]() is not setup:
+        cached = (weakref.ref(setup, lambda _, key=key: _REFERENCES.pop(key, None)), _Reference(setup))
+        _REFERENCES[key] = cached
+    return cached[1]
 
 
 def closure_measures(setup: ClosureSetup, u: np.ndarray, t: float = 1.5) -> ClosureMeasures:
     """Orifice, leaflet and coaptation areas and leaflet-centre stresses at state ``u`` (module docstring)."""
-    reference = _REFERENCES.setdefault(id(setup), _Reference(setup))
+    reference = _reference(setup).measure(setup)
     x = abaqus_positions(setup, u)
     areas = valve_areas(reference.surfaces, x, reference.annulus, centre_faces=reference.centre_faces)
     leaflet_area = {which: areas.total(which) for which in areas.orifice}
     coaptation = setup.contact.contact_area(u, t=t)
     principal = max_principal_cauchy(setup, u)
     centre = {name: float(principal[elements].mean()) for name, elements in reference.centre_elements.items()}
-    return ClosureMeasures(areas.orifice, leaflet_area, coaptation, centre)
+    return ClosureMeasures(areas.orifice, leaflet_area, coaptation, centre, areas.leaflet)
 
 
 def max_principal_cauchy(setup: ClosureSetup, u: np.ndarray) -> np.ndarray:
