@@ -17,7 +17,7 @@ from scipy.spatial.transform import Rotation
 
 from skvalve.io.abaqus import read_model, trivalve_inputs
 from skvalve.papers.mathur2022.data import LEAFLET_THICKNESS, TABLE2_AREAS
-from skvalve.valve.closure import closure_setup
+from skvalve.valve.closure import ClosureSetup, closure_setup
 from skvalve.valve.geometry import (
     annulus_nodes,
     boundary_loops,
@@ -30,6 +30,7 @@ from skvalve.valve.geometry import (
     surface_area,
     valve_areas,
 )
+from skvalve.valve.model import valve_model
 from skvalve.valve.outputs import abaqus_positions, closure_measures
 
 ROTATION = Rotation.from_rotvec([0.3, -1.1, 0.7]).as_matrix()
@@ -241,11 +242,9 @@ def test_leaflet_surfaces_of_a_brick_band(tmp_path, layers):
             assert areas.orifice[which] == pytest.approx(scale**2 * 0.5 * n * r**2 * np.sin(2 * np.pi / n), rel=1e-12)
 
 
-@pytest.mark.parametrize("triangles", [False, True])
-def test_leaflet_surfaces_of_a_shell_band(tmp_path, triangles):
-    """S4R band: the mid surface is the shells', SPOS (outward here) the ventricular side at +t/2. The same band
-    of S3 triangles (each rectangle split in two): the same mid-surface and orifice areas."""
-    radius, thickness, height, n, rows = 10.0, 0.65, 6.0, 24, 4
+def _shell_band_deck(radius, thickness, height, n, rows, triangles=False):
+    """A cylindrical band of S4R quads (or S3 halves of them) in three leaflet sectors, annulus at z = 0, a
+    Lee-Sacks (VUANISO_ISO) material; returns the deck and the element labels of each sector."""
     lines = ["*Node"]
     for k in range(rows + 1):
         for j in range(n):
@@ -266,11 +265,22 @@ def test_leaflet_surfaces_of_a_shell_band(tmp_path, triangles):
     for name, labels in sectors.items():
         lines += [f"*Elset, elset={name}_Leaflet_Elements", *(f"{v}," for v in labels),
                   f"*Shell Section, elset={name}_Leaflet_Elements, material=M", f"{thickness}, 5"]
-    lines += ["*Material, name=M", "*Surface, name=Leaflets", *(f"{name}_Leaflet_Elements, SPOS" for name in names),
+    lines += ["*Material, name=M", "*Anisotropic Hyperelastic, user, formulation=invariant, properties=4",
+              "0.001, 20.0, 0.000124, 4.57",
+              "*Surface, name=Leaflets", *(f"{name}_Leaflet_Elements, SPOS" for name in names),
               "*Nset, nset=Annular_Nodes", *(f"{j + 1}," for j in range(n)),
               "*Step", "*Static", "*Dsload", "Leaflets, P, 0.003", "*End Step"]
+    return "\n".join(lines) + "\n", sectors
+
+
+@pytest.mark.parametrize("triangles", [False, True])
+def test_leaflet_surfaces_of_a_shell_band(tmp_path, triangles):
+    """S4R band: the mid surface is the shells', SPOS (outward here) the ventricular side at +t/2. The same band
+    of S3 triangles (each rectangle split in two): the same mid-surface and orifice areas."""
+    radius, thickness, height, n, rows = 10.0, 0.65, 6.0, 24, 4
+    deck, sectors = _shell_band_deck(radius, thickness, height, n, rows, triangles)
     path = tmp_path / "shells.inp"
-    path.write_text("\n".join(lines) + "\n")
+    path.write_text(deck)
     logging.getLogger("skvalve.io.abaqus.reader").setLevel(logging.ERROR)
     model = read_model(path)
     surfaces = leaflet_surfaces(model)
@@ -404,3 +414,26 @@ def test_trivalve_shell_measures_under_a_uniform_stretch(shell_valve):
         (section,) = [s for s in model.sections if s.elset.upper().endswith(f".{leaflet.upper()}_LEAFLET_ELEMENTS")]
         c0, D, c1, c2 = model.material(section.material).option("anisotropic hyperelastic").data
         assert value == pytest.approx(_lee_sacks_max_principal(F, c0, D, c1, c2), rel=1e-9)
+
+
+@pytest.mark.parametrize("layers", [1, 3, 4])
+def test_shell_nodes_follow_the_middle_of_their_extruded_fibre(tmp_path, layers):
+    """abaqus_positions of a shell band extruded into ``layers`` hexes: the input node is the middle layer
+    (even) or the mean of the two middle layers (odd). Under u = a |X|^2 e_z the fibre points X +- d n,
+    d = h / (2 layers), average to X + a (|X|^2 + d^2) e_z, an even stack's middle node to X + a |X|^2 e_z."""
+    radius, thickness = 10.0, 0.65
+    path = tmp_path / "shells.inp"
+    path.write_text(_shell_band_deck(radius, thickness, 6.0, 24, 4)[0])
+    logging.getLogger("skvalve.io.abaqus.reader").setLevel(logging.ERROR)
+    abaqus = read_model(path)
+    model = valve_model(abaqus, layers=layers)
+    problem = model.problem()
+    setup = ClosureSetup(abaqus, model, problem, None, None, np.zeros(model.mesh.p.shape[1], dtype=int))
+    X = model.mesh.p.T
+    u = np.zeros(problem.space.n_dofs)
+    np.testing.assert_allclose(abaqus_positions(setup, u), abaqus.nodes, rtol=0, atol=1e-13 * radius)
+    a = 0.01
+    u[: problem.space.n_u] = (a * (X**2).sum(axis=1)[:, None] * np.array([0.0, 0.0, 1.0])).ravel()
+    d2 = 0.0 if layers % 2 == 0 else (thickness / (2 * layers)) ** 2
+    expected = abaqus.nodes + a * ((abaqus.nodes**2).sum(axis=1) + d2)[:, None] * np.array([0.0, 0.0, 1.0])
+    np.testing.assert_allclose(abaqus_positions(setup, u), expected, rtol=0, atol=1e-12 * radius)
