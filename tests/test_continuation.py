@@ -95,3 +95,25 @@ def test_slack_cable_turning_taut_in_one_step_needs_no_cut_back():
     many = reference.solve(steps=40, progress=False, rtol=1e-10, max_iter=40)
     assert np.allclose(one.u(), many.u(), rtol=0, atol=1e-8 * np.abs(many.u()).max())
     assert chord.response(one.u()).axial_force[0] > 0.0  # taut at the end
+
+
+def test_stiffness_scale_softens_the_taut_law_and_keeps_the_slack_spring():
+    """A softened cable must keep its slack spring: scaling it too leaves the ends of slack cables (chordae
+    branch points) without support, and Newton's steps there blow up."""
+    cable = TensionOnly(LinearUniaxial(100.0), slack_fraction=1e-3, transition=0.0)
+    stretch = np.array([0.9, 0.97, 1.05, 1.2])
+    slack = np.full(4, 0.95)
+    P1, dP1 = cable.nominal_stress(stretch, slack)
+    Ps, dPs = cable.nominal_stress(stretch, slack, 0.01)
+    k = 1e-3 * 100.0
+    expected = k * (stretch - 0.95) + 0.01 * np.where(stretch >= 1.0, 100.0 * (stretch - 1.0), 0.0)
+    assert np.allclose(Ps, expected, rtol=1e-14, atol=1e-16)
+    assert np.allclose(Ps[:2], P1[:2], rtol=1e-14) and np.allclose(dPs[:2], k, rtol=1e-14)
+    assert np.allclose(dPs[2:], k + 0.01 * 100.0, rtol=1e-14)
+    space, a, b = _two_nodes()
+    truss = Truss(space, [[a, b]], 0.5, cable, rest_length=[2.2], slack_stretch=[2.0 / 2.2],
+                  stiffness_scale=lambda t: 0.01)
+    u = np.zeros(space.n_dofs)
+    u[3 * b] = -0.1  # slack: only the spring, unscaled
+    force = truss.assemble(u, 0.0, False, 1).internal[3 * b]
+    assert force == pytest.approx(0.5 * k * (1.9 / 2.2 - 2.0 / 2.2), rel=1e-12)

@@ -32,7 +32,26 @@ from ..materials.uniaxial import TensionOnly, UniaxialLaw
 from .space import Space
 from .terms import Blocks, Contribution, Term
 
-__all__ = ["BarResponse", "bar_response", "LawAssignment", "Truss"]
+__all__ = ["BarResponse", "bar_response", "BarEnd", "LawAssignment", "Truss"]
+
+
+@dataclass
+class BarEnd:
+    r"""One end of every bar as a fixed weighted average of nodes, :math:`x = \sum_j w_j x_{n_j}`
+    (a distributing coupling: the end's force goes to the nodes in proportion to :math:`w_j`).
+
+    nodes, weights : (n_bars, k) scalar dof (node) indices and weights, each row summing to 1 (pad a short row
+    with any node and weight 0).
+    """
+
+    nodes: np.ndarray
+    weights: np.ndarray
+
+    @classmethod
+    def single(cls, nodes: np.ndarray) -> BarEnd:
+        """Each bar end at one node."""
+        nodes = np.asarray(nodes, dtype=np.int64).reshape(-1, 1)
+        return cls(nodes, np.ones(nodes.shape, dtype=float))
 
 
 @dataclass
@@ -67,21 +86,27 @@ class LawAssignment:
         if n_bars and (self.index.min() < 0 or self.index.max() >= len(self.laws)):
             raise ValueError(f"law_index must lie in 0..{len(self.laws) - 1}")
 
-    def evaluate(self, stretch: np.ndarray, slack_stretch: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Nominal stress and slope of every bar (``slack_stretch`` per bar for tension-only laws)."""
+    def evaluate(self, stretch: np.ndarray, slack_stretch: np.ndarray | None = None, scale: float = 1.0
+                 ) -> tuple[np.ndarray, np.ndarray]:
+        """Nominal stress and slope of every bar (``slack_stretch`` per bar for tension-only laws); ``scale``
+        multiplies each law (for tension-only laws the taut law only, not the slack spring)."""
         P, dP = np.empty_like(stretch), np.empty_like(stretch)
         for k, law in enumerate(self.laws):
             mine = self.index == k
-            if np.any(mine):
-                if slack_stretch is None:
-                    P[mine], dP[mine] = law.nominal_stress(stretch[mine])
-                else:
-                    P[mine], dP[mine] = law.nominal_stress(stretch[mine], slack_stretch[mine])
+            if not np.any(mine):
+                continue
+            if isinstance(law, TensionOnly):
+                slack = 1.0 if slack_stretch is None else slack_stretch[mine]
+                P[mine], dP[mine] = law.nominal_stress(stretch[mine], slack, scale)
+            else:
+                P_k, dP_k = law.nominal_stress(stretch[mine])
+                P[mine], dP[mine] = scale * P_k, scale * dP_k
         return P, dP
 
 
 def bar_response(x_a: np.ndarray, x_b: np.ndarray, rest_length: np.ndarray, area: np.ndarray,
-                 laws: LawAssignment, tangent: bool = True, slack_stretch: np.ndarray | None = None) -> BarResponse:
+                 laws: LawAssignment, tangent: bool = True, slack_stretch: np.ndarray | None = None,
+                 scale: float = 1.0) -> BarResponse:
     """Forces and tangents of bars with current end positions ``x_a, x_b`` of shape (n, 3) (module docstring).
 
     ``slack_stretch``: per-bar force-free stretch of tension-only laws
@@ -95,7 +120,7 @@ def bar_response(x_a: np.ndarray, x_b: np.ndarray, rest_length: np.ndarray, area
         raise ValueError(f"truss: zero or non-finite current length in bar(s) {np.flatnonzero(bad)[:10].tolist()}")
     n = d / length[:, None]
     stretch = length / rest_length
-    P, dP = laws.evaluate(stretch, slack_stretch)
+    P, dP = laws.evaluate(stretch, slack_stretch, scale)
     N = area * P
     f = N[:, None] * n
     forces = np.hstack([-f, f])
@@ -128,34 +153,35 @@ class Truss(Term):
     slack_stretch : per-bar force-free stretch (<= 1) of tension-only laws, e.g. the reference distance over
         the rest length of a collapsed chain, so that a curved chain starts stress-free.
     name : shown in error messages.
-    stiffness_scale : optional :math:`s(t) > 0` multiplying every bar's force and tangent (the stored energy
-        :math:`s W`): a continuation parameter, e.g. cables that start soft and stiffen to their law
+    stiffness_scale : optional :math:`s(t) > 0` multiplying every bar's law (a tension-only cable's taut law only:
+        its slack spring, which keeps slack cable ends supported, is not scaled): a continuation parameter, e.g.
+        cables that start soft and stiffen to their law
         (:class:`~skvalve.fem.amplitudes.GeometricRamp`); ``None`` is :math:`s = 1`.
     """
 
-    def __init__(self, space: Space, nodes: np.ndarray, area, laws, law_index: np.ndarray | None = None,
+    def __init__(self, space: Space, nodes, area, laws, law_index: np.ndarray | None = None,
                  rest_length: np.ndarray | None = None, slack_stretch: np.ndarray | None = None,
                  name: str = "truss", stiffness_scale: Callable[[float], float] | None = None) -> None:
         if space.dim != 3:
             raise ValueError(f"{name}: trusses need a 3D displacement space; got dimension {space.dim}")
-        nodes = np.asarray(nodes, dtype=np.int64)
-        if nodes.ndim != 2 or nodes.shape[1] != 2:
-            raise ValueError(f"{name}: nodes must have shape (n_bars, 2); got {nodes.shape}")
-        if nodes.size and (nodes.min() < 0 or nodes.max() >= space.n_scalar):
-            raise ValueError(f"{name}: node indices must lie in 0..{space.n_scalar - 1}")
-        same = np.flatnonzero(nodes[:, 0] == nodes[:, 1])
-        if same.size:
-            raise ValueError(f"{name}: bar(s) {same[:10].tolist()} join a node to itself")
+        ends = _bar_ends(nodes, name, space.n_scalar)
         self.name = name
         self.stiffness_scale = stiffness_scale
         self.space = space
-        self.nodes = nodes
-        self.n_bars = nodes.shape[0]
-        self.dofs = np.ascontiguousarray((3 * nodes[:, :, None] + np.arange(3)).reshape(self.n_bars, 6))
+        self.ends = ends
+        self.nodes = np.column_stack([end.nodes[np.arange(end.nodes.shape[0]), np.argmax(end.weights, axis=1)]
+                                      for end in ends])
+        self.n_bars = self.nodes.shape[0]
+        self.dofs = np.ascontiguousarray(np.hstack([(3 * end.nodes[:, :, None] + np.arange(3)).reshape(self.n_bars, -1)
+                                                    for end in ends]))
+        self.distributed = any(end.nodes.shape[1] > 1 for end in ends)
         # a linear space numbers its scalar dofs like the mesh vertices; mesh.p also holds vertices that no
         # cell uses (nodes of the trusses only), for which the basis has no location
         X = (space.mesh.p if space.order == 1 else space.dof_coordinates).T
-        self.reference = (X[nodes[:, 0]], X[nodes[:, 1]])
+        self.reference = tuple(np.einsum("nk,nkd->nd", end.weights, X[end.nodes]) for end in ends)
+        same = np.flatnonzero(np.all(self.reference[0] == self.reference[1], axis=1))
+        if same.size:
+            raise ValueError(f"{name}: bar(s) {same[:10].tolist()} join a point to itself")
         chord = np.linalg.norm(self.reference[1] - self.reference[0], axis=1)
         self.rest_length = chord if rest_length is None else np.asarray(rest_length, dtype=float).ravel()
         self.area = np.broadcast_to(np.asarray(area, dtype=float), (self.n_bars,)).copy()
@@ -178,24 +204,69 @@ class Truss(Term):
     def connectivity(self) -> list[np.ndarray]:
         return [self.dofs]
 
-    def response(self, u: np.ndarray, tangent: bool = False) -> BarResponse:
-        """Stretch, axial force and element forces/tangents of every bar at displacement ``u``."""
-        ue = u[self.dofs]
-        return bar_response(self.reference[0] + ue[:, :3], self.reference[1] + ue[:, 3:], self.rest_length,
-                            self.area, self.laws, tangent, self.slack_stretch)
+    def response(self, u: np.ndarray, tangent: bool = False, scale: float = 1.0) -> BarResponse:
+        """Stretch, axial force and element forces/tangents of every bar at displacement ``u`` (element vectors
+        and matrices on ``self.dofs``: the nodes of both ends); ``scale`` as ``stiffness_scale``."""
+        nodal = u[: 3 * self.space.n_scalar].reshape(-1, 3)
+        x_a, x_b = (ref + np.einsum("nk,nkd->nd", end.weights, nodal[end.nodes])
+                    for ref, end in zip(self.reference, self.ends, strict=True))
+        state = bar_response(x_a, x_b, self.rest_length, self.area, self.laws, tangent, self.slack_stretch, scale)
+        if not self.distributed:
+            return state
+        spread = _spreading(self.ends)  # (n, 6, m): end positions from the nodes' displacements
+        spread_t = spread.transpose(0, 2, 1)
+        state.forces = np.matmul(spread_t, state.forces[:, :, None])[:, :, 0]
+        if state.matrices is not None:
+            state.matrices = np.matmul(np.matmul(spread_t, state.matrices), spread)
+        return state
 
     def assemble(self, u: np.ndarray, t: float, tangent: bool, step: int | None) -> Contribution:
-        try:
-            state = self.response(u, tangent)
-        except ValueError as err:
-            raise ValueError(f"{err} (load step {step}, load factor {t})") from err
-        forces, matrices = state.forces, state.matrices
+        scale = 1.0
         if self.stiffness_scale is not None:
             scale = float(self.stiffness_scale(t))
             if not (np.isfinite(scale) and scale > 0.0):
                 raise ValueError(f"{self.name}: stiffness_scale must be positive and finite; got {scale!r} at load "
                                  f"factor {t} (load step {step})")
-            forces = scale * forces
-            matrices = None if matrices is None else scale * matrices
-        internal = np.bincount(self.dofs.ravel(), forces.ravel(), minlength=self.space.n_dofs)
-        return Contribution(internal=internal, blocks=[Blocks(self.dofs, matrices)])
+        try:
+            state = self.response(u, tangent, scale)
+        except ValueError as err:
+            raise ValueError(f"{err} (load step {step}, load factor {t})") from err
+        internal = np.bincount(self.dofs.ravel(), state.forces.ravel(), minlength=self.space.n_dofs)
+        return Contribution(internal=internal, blocks=[Blocks(self.dofs, state.matrices)])
+
+
+def _bar_ends(nodes, name: str, n_scalar: int) -> tuple[BarEnd, BarEnd]:
+    """Two :class:`BarEnd` from an (n_bars, 2) node array or a pair of ends; checks indices and weights."""
+    if isinstance(nodes, tuple | list) and len(nodes) == 2 and all(isinstance(e, BarEnd) for e in nodes):
+        ends = tuple(BarEnd(np.asarray(e.nodes, dtype=np.int64), np.asarray(e.weights, dtype=float)) for e in nodes)
+    else:
+        nodes = np.asarray(nodes, dtype=np.int64)
+        if nodes.ndim != 2 or nodes.shape[1] != 2:
+            raise ValueError(f"{name}: nodes must have shape (n_bars, 2) or be two BarEnd; got {nodes.shape}")
+        same = np.flatnonzero(nodes[:, 0] == nodes[:, 1])
+        if same.size:
+            raise ValueError(f"{name}: bar(s) {same[:10].tolist()} join a node to itself")
+        ends = (BarEnd.single(nodes[:, 0]), BarEnd.single(nodes[:, 1]))
+    for label, end in zip("ab", ends, strict=True):
+        if end.nodes.ndim != 2 or end.nodes.shape != end.weights.shape or end.nodes.shape[0] != ends[0].nodes.shape[0]:
+            raise ValueError(f"{name}: end {label}: nodes and weights must both be (n_bars, k)")
+        if end.nodes.size and (end.nodes.min() < 0 or end.nodes.max() >= n_scalar):
+            raise ValueError(f"{name}: node indices must lie in 0..{n_scalar - 1}")
+        bad = np.flatnonzero(~np.isclose(end.weights.sum(axis=1), 1.0, rtol=0, atol=1e-12) |
+                             np.any(~np.isfinite(end.weights), axis=1))
+        if bad.size:
+            raise ValueError(f"{name}: end {label}: weights of bar(s) {bad[:10].tolist()} do not sum to 1")
+    return ends
+
+
+def _spreading(ends: tuple[BarEnd, BarEnd]) -> np.ndarray:
+    """(n_bars, 6, 3 (k_a + k_b)): the matrix taking the element dofs to the two end displacements."""
+    n = ends[0].nodes.shape[0]
+    blocks = []
+    for e, end in enumerate(ends):
+        k = end.nodes.shape[1]
+        block = np.zeros((n, 6, 3 * k))
+        for d in range(3):
+            block[:, 3 * e + d, d::3] = end.weights
+        blocks.append(block)
+    return np.concatenate(blocks, axis=2)

@@ -160,8 +160,10 @@ class TensionOnly:
     def young_modulus(self) -> float:
         return float(self.law.nominal_stress(np.ones(1))[1][0])
 
-    def nominal_stress(self, stretch: ArrayLike, slack_stretch: ArrayLike = 1.0) -> tuple[np.ndarray, np.ndarray]:
-        """:math:`P` and :math:`dP/d\\lambda`; ``slack_stretch`` :math:`\\lambda_s \\le 1` (broadcast)."""
+    def nominal_stress(self, stretch: ArrayLike, slack_stretch: ArrayLike = 1.0, scale: float = 1.0
+                       ) -> tuple[np.ndarray, np.ndarray]:
+        """:math:`P` and :math:`dP/d\\lambda`; ``slack_stretch`` :math:`\\lambda_s \\le 1` (broadcast); ``scale``
+        multiplies the taut law only (a continuation that softens the cable keeps its slack spring)."""
         lam = _positive_stretch(stretch, "TensionOnly")
         lam_s = np.asarray(slack_stretch, dtype=float)
         if np.any(~(lam_s > 0.0) | (lam_s > 1.0)):
@@ -173,7 +175,7 @@ class TensionOnly:
             w, dw = x * x * (3.0 - 2.0 * x), 6.0 * x * (1.0 - x) / self.transition
         else:
             w, dw = (lam >= 1.0).astype(float), np.zeros_like(lam)
-        P = k * (lam - lam_s) + w * Pl
-        dP = k + dw * Pl + w * dPl
+        P = k * (lam - lam_s) + scale * w * Pl
+        dP = k + scale * (dw * Pl + w * dPl)
         return P, dP
 

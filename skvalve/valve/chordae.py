@@ -26,9 +26,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..fem.truss import LawAssignment, bar_response
+from ..fem.truss import BarEnd, LawAssignment, bar_response
 
-__all__ = ["CollapsedChordae", "collapse_chains", "tangent_on_free_nodes"]
+__all__ = ["CollapsedChordae", "collapse_chains", "tangent_on_free_nodes", "insertion_patches"]
 
 
 @dataclass
@@ -180,3 +180,46 @@ def tangent_on_free_nodes(ends: np.ndarray, coordinates: np.ndarray, rest_length
         index = dofs[e][keep]
         K[np.ix_(index, index)] += state.matrices[e][np.ix_(keep, keep)]
     return K, free
+
+
+def insertion_patches(cells: np.ndarray, points: np.ndarray, ends: np.ndarray, rest_length: np.ndarray
+                      ) -> tuple[tuple[BarEnd, BarEnd], np.ndarray, np.ndarray]:
+    r"""Cable ends spread over the leaflet around their insertion: a distributing coupling.
+
+    A cable end at a vertex of the leaflet mesh becomes the average of all vertices of the cells around it
+    (equal weights; the force goes to them in equal shares) instead of a point load on one node, which on
+    leaflets as soft as the TriValve's (:math:`C_0 = 1` kPa) distorts the few elements around the node far
+    beyond what the cable's neighbourhood sees in a tissue where chordae fan out as they insert. Ends at
+    vertices no cell uses (papillary tips, branch points) stay single. The patch centroid lies within about
+    half an element of the node, so each cable's rest length is shifted by the change of its reference chord,
+    keeping its slack (path length minus chord) and its force-free reference state:
+
+    .. math::
+
+        L' = L + \big(|X'_b - X'_a| - |X_b - X_a|\big), \qquad \lambda'_s = |X'_b - X'_a| / L'.
+
+    Parameters: ``cells`` (n_nodes_per_cell, n_cells), ``points`` (3, n_vertices), cable ``ends`` (n, 2),
+    ``rest_length`` (n,). Returns the two :class:`~skvalve.fem.truss.BarEnd`, the new rest lengths and the
+    slack stretches.
+    """
+    n_vertices = points.shape[1]
+    owner = np.repeat(np.arange(cells.shape[1]), cells.shape[0])
+    order = np.argsort(cells.T.ravel(), kind="stable")
+    vertex_sorted = cells.T.ravel()[order]
+    first = np.searchsorted(vertex_sorted, np.arange(n_vertices + 1))
+    X = points.T
+    built = []
+    for column in range(2):
+        rows = []
+        for vertex in ends[:, column]:
+            around = owner[order[first[vertex]:first[vertex + 1]]]
+            rows.append(np.unique(cells[:, around]) if around.size else np.array([vertex]))
+        width = max(len(r) for r in rows)
+        nodes = np.array([np.pad(r, (0, width - len(r)), constant_values=r[0]) for r in rows], dtype=np.int64)
+        weights = np.array([np.pad(np.full(len(r), 1.0 / len(r)), (0, width - len(r))) for r in rows])
+        built.append(BarEnd(nodes, weights))
+    chord = np.linalg.norm(X[ends[:, 1]] - X[ends[:, 0]], axis=1)
+    centres = [np.einsum("nk,nkd->nd", end.weights, X[end.nodes]) for end in built]
+    new_chord = np.linalg.norm(centres[1] - centres[0], axis=1)
+    rest = rest_length + (new_chord - chord)
+    return (built[0], built[1]), rest, np.minimum(new_chord / rest, 1.0)

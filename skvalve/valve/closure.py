@@ -52,11 +52,14 @@ class ClosureOptions:
     pressure_start : step time at which the pressure amplitude starts (0.5 in the 1.0 inputs: papillary motion
     first; 0 where everything ramps together, as in the 1.1 healthy input).
     end : last step time (1.5 = end-systole; less for a partial closure).
+    insertion : ``"patch"`` spreads each chord's pull over the cells around its insertion (a modelling
+    change from the input's point attachment, see :func:`~skvalve.valve.chordae.insertion_patches`), ``"node"``
+    keeps the point attachment.
     :meth:`for_model` derives ``end``, ``pressure_start``, ``damping_off`` and ``cable_stiffening`` from an input.
     rtol, atol : Newton tolerances: relative to reactions/loads, and an absolute floor (N) for the papillary
     stage, whose loads and reactions are nearly zero (pressure load at the end: about 8 N).
-    cable_softening, cable_stiffening : the chordae start with their law scaled by ``cable_softening`` and
-    stiffen geometrically to it over the step-time interval ``cable_stiffening``
+    cable_softening, cable_stiffening : the chordae (and any other bars: annuloplasty links) start with their law
+    scaled by ``cable_softening`` and stiffen geometrically to it over the step-time interval ``cable_stiffening``
     (:class:`~skvalve.fem.amplitudes.GeometricRamp`); 1 switches the continuation off.
     path_rtol, path_atol : looser tolerances for the steps while the damping acts (a pseudo-transient path,
     not equilibria of the problem); the steps from ``damping_off`` on are solved to ``rtol, atol``.
@@ -78,6 +81,7 @@ class ClosureOptions:
     path_atol: float = 1e-5
     cable_stiffening: tuple[float, float] = (0.4, 0.6)
     pressure_start: float = 0.5
+    insertion: str = "patch"
 
     @classmethod
     def for_model(cls, model: ValveModel, **overrides) -> ClosureOptions:
@@ -145,7 +149,7 @@ def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: Abaq
                                     "folder (model files of Mathur et al. 2022, CC BY-NC-SA 4.0)")
         abaqus = read_model(path)
     model = valve_model(abaqus) if model is None else model
-    problem = model.problem()
+    problem = model.problem(insertion=options.insertion)
     if options.cable_softening != 1.0:
         ramp = GeometricRamp(options.cable_softening, *options.cable_stiffening)
         for term in problem.terms:

@@ -51,7 +51,7 @@ from ..fem.truss import Truss
 from ..io.abaqus import HEX_FACE_NODES, AbaqusModel
 from ..materials import LeeSacks
 from ..materials.uniaxial import OgdenUniaxial, TensionOnly
-from .chordae import CollapsedChordae, collapse_chains
+from .chordae import CollapsedChordae, collapse_chains, insertion_patches
 from .extrude import extrude_shell, hex_corner_jacobians
 from .links import LINK_FACTOR, Links, link_constraints, link_nodes
 from .support import check_supported
@@ -174,7 +174,8 @@ class ValveModel:
                           self.notes + [f"submodel of {names}: {int(inside.sum())} of {inside.size} cables kept"],
                           self.links.subset(new) if self.links is not None else None)
 
-    def problem(self, solid: str = "fbar", slack_fraction: float = 1e-6, transition: float = 0.01) -> Problem:
+    def problem(self, solid: str = "fbar", slack_fraction: float = 1e-6, transition: float = 0.01,
+                insertion: str = "node") -> Problem:
         """A :class:`~skvalve.fem.Problem` of the model (load factor = step time).
 
         ``solid``: ``"fbar"`` (F-bar mean-dilatation hexes, default) or ``"q1"`` (full integration, locks).
@@ -183,6 +184,8 @@ class ValveModel:
         TriValve chordae) well below the leaflets' :math:`C_0 = 10^{-3}` MPa. Each cable is force-free in the
         reference state (slack stretch = reference end-to-end distance / path length).
         ``transition``: stretch interval over which a cable's slope ramps from slack to taut (C1, for Newton).
+        ``insertion``: ``"node"`` (the input's point attachment) or ``"patch"`` (each cable end on the leaflet
+        spread over the vertices of the cells around it: :func:`~skvalve.valve.chordae.insertion_patches`).
         """
         space = Space(self.mesh)
         materials = MaterialRegions(self.mesh, list(self.laws), self.regions)
@@ -195,9 +198,13 @@ class ValveModel:
         problem = Problem(space, [leaflets])
         ch = self.chordae
         cables = [TensionOnly(law, slack_fraction, transition) for law in ch.laws]
+        if insertion not in ("node", "patch"):
+            raise ValueError(f"insertion must be 'node' or 'patch'; got {insertion!r}")
         if ch.ends.shape[0]:
-            problem.add_term(Truss(space, ch.ends, ch.area, cables, ch.law_index, ch.rest_length, ch.slack_stretch,
-                                   name="chordae"))
+            ends, rest, slack = ch.ends, ch.rest_length, ch.slack_stretch
+            if insertion == "patch":
+                ends, rest, slack = insertion_patches(self.mesh.t, self.mesh.p, ch.ends, ch.rest_length)
+            problem.add_term(Truss(space, ends, ch.area, cables, ch.law_index, rest, slack, name="chordae"))
         if self.links is not None and self.links.size:
             problem.add_term(self.links.term(space))
         for load in self.pressures:
