@@ -117,3 +117,27 @@ def test_stiffness_scale_softens_the_taut_law_and_keeps_the_slack_spring():
     u[3 * b] = -0.1  # slack: only the spring, unscaled
     force = truss.assemble(u, 0.0, False, 1).internal[3 * b]
     assert force == pytest.approx(0.5 * k * (1.9 / 2.2 - 2.0 / 2.2), rel=1e-12)
+
+
+def test_max_increment_caps_the_step_and_reaches_the_same_state():
+    """A cantilever block under a large tip load: uncapped Newton moves some node more than 0.1 in one
+    iteration; with max_increment = 0.05 every accepted iterate moves no node further than that, more iterations are
+    needed, and the converged state is the same."""
+    def build():
+        solid = Solid(skfem.MeshHex().refined(1), NeoHookean(1.0, 10.0))
+        X = solid.space.dof_coordinates
+        solid.add_dirichlet(lambda X: X[0] < 1e-9, 0.0)
+        solid.add_term(NodalForce(solid.space, np.flatnonzero(np.isclose(X[0], 1.0)), [0.0, 0.0, 0.05], ramp=True))
+        return solid
+
+    free = build().solve(steps=1, progress=False, rtol=1e-10)
+    capped = solve(build(), steps=1, progress=False, rtol=1e-10, max_iter=60, max_increment=0.05)
+    assert np.allclose(capped.u(), free.u(), rtol=0, atol=1e-9)
+    assert capped.iterations > free.iterations
+    assert np.linalg.norm(free.u().reshape(-1, 3), axis=1).max() > 0.3  # the cap had work to do
+    alphas = [record["alpha"] for record in capped.histories[1]]
+    assert min(alphas) < 1.0
+    assert max(record["largest_increment"] for record in capped.histories[1]) <= 0.05 * (1 + 1e-12)
+    assert max(record["largest_increment"] for record in free.histories[1]) > 0.1
+    with pytest.raises(ValueError, match="max_increment"):
+        solve(build(), steps=1, progress=False, max_increment=-1.0)

@@ -75,6 +75,7 @@ class NewtonOptions:
     max_line_search: int = 4
     solver: str = "scipy"
     verbose: bool = False
+    max_increment: float | None = None
     timings: dict = field(default_factory=lambda: {"setup": 0.0, "assembly": 0.0, "solve": 0.0})
 
     def __post_init__(self) -> None:
@@ -86,6 +87,9 @@ class NewtonOptions:
             isinstance(self.energy_tol, int | float) and math.isfinite(self.energy_tol) and self.energy_tol > 0
         ):
             raise ValueError(f"energy_tol must be None or a positive finite number; got {self.energy_tol!r}")
+        if self.max_increment is not None and not (isinstance(self.max_increment, int | float)
+                                                   and math.isfinite(self.max_increment) and self.max_increment > 0):
+            raise ValueError(f"max_increment must be None or a positive finite length; got {self.max_increment!r}")
         for name, low in (("max_iter", 1), ("max_cutbacks", 0), ("max_line_search", 0)):
             value = getattr(self, name)
             if not isinstance(value, int | np.integer) or isinstance(value, bool) or value < low:
@@ -176,7 +180,8 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
         du[free] = du_free
         energy = abs(du_free @ rhs[free])
         energy0 = energy if energy0 is None else energy0
-        alpha, accepted = 1.0, None
+        alpha, accepted = _capped_length(problem, du, opts.max_increment), None
+        shortest = alpha * 2.0 ** -opts.max_line_search * 1.5
         baseline = norm
         if moved and iteration == 1 and opts.line_search:
             # the predictor's |R| is linearised about u_n; the line search's short-step limit is the true
@@ -198,7 +203,7 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
             if not opts.line_search or trial_norm <= baseline:
                 accepted = (trial, trial_residual, trial_tangent, trial_norm)
                 break
-            if alpha < 2.0 ** -opts.max_line_search * 1.5:
+            if alpha < shortest:
                 # no length reduced |R|: take the shortest one unless the residual blows up (then cut back)
                 if not trial_norm <= _BLOW_UP * baseline:
                     raise _StepFailed(f"line search: the residual grows from {baseline:.3e} to {trial_norm:.3e} "
@@ -215,7 +220,8 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
         relative_energy = energy / energy0 if energy0 > 0 else 0.0
         record = {"step": step, "load_factor": t_new, "iteration": iteration, "residual": norm,
                   "relative_residual": relative, "increment": float(np.linalg.norm(alpha * du_free)),
-                  "relative_energy": relative_energy, "alpha": alpha}
+                  "relative_energy": relative_energy, "alpha": alpha,
+                  "largest_increment": alpha * _largest_nodal(problem, du)}
         history.append(record)
         logger.info("step %d t=%.4g it %d |R|=%.3e rel=%.3e |du|=%.3e energy=%.3e alpha=%.3g", step, t_new,
                     iteration, norm, relative, record["increment"], relative_energy, alpha)
@@ -228,6 +234,20 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
         if (relative <= opts.rtol or norm <= opts.atol) and energy_ok:
             return u, residual, history, tangent
     raise _StepFailed(f"no convergence in {opts.max_iter} iterations (relative residual {relative:.3e})")
+
+
+def _largest_nodal(problem: Problem, du: np.ndarray) -> float:
+    """The largest nodal displacement change in ``du``."""
+    space = problem.space
+    return float(np.max(np.linalg.norm(du[: space.n_u].reshape(-1, space.dim), axis=1), initial=0.0))
+
+
+def _capped_length(problem: Problem, du: np.ndarray, max_increment: float | None) -> float:
+    """The first line-search length: 1, or less so that no node moves more than ``max_increment``."""
+    if max_increment is None:
+        return 1.0
+    largest = _largest_nodal(problem, du)
+    return 1.0 if largest <= max_increment else max_increment / largest
 
 
 def _true_residual(problem: Problem, u: np.ndarray, t: float, step: int, free: np.ndarray,
@@ -258,7 +278,8 @@ def _notify(callbacks, event: StepEvent) -> None:
 def solve(problem: Problem, steps=10, *, rtol: float = 1e-8, atol: float = 0.0, energy_tol: float | None = None,
           max_iter: int = 25, max_cutbacks: int = 6, line_search: bool = True, max_line_search: int = 4,
           solver: str | None = None, progress: bool = True, verbose: bool = False, u0: np.ndarray | None = None,
-          t0: float = 0.0, callbacks: Sequence[Callable[[StepEvent], None]] = ()) -> Result:
+          t0: float = 0.0, callbacks: Sequence[Callable[[StepEvent], None]] = (),
+          max_increment: float | None = None) -> Result:
     """Solve the load path ``t`` in ``steps`` (int: uniform steps to 1; or increasing factors).
 
     Parameters
@@ -274,6 +295,9 @@ def solve(problem: Problem, steps=10, *, rtol: float = 1e-8, atol: float = 0.0, 
     callbacks : called with a :class:`StepEvent` after the initial state and each converged step
         (e.g. :class:`skvalve.io.timeseries.TimeSeriesWriter`); a callback that raises ends the
         solve with :class:`OutputError` carrying the converged steps.
+    max_increment : optional cap (length units) on any node's displacement change in one iteration: the line
+        search starts from the step length that meets it (a trust region against Newton steps thrown far by
+        nearly free directions, e.g. cable branch points between slack and taut).
 
     Returns
     -------
@@ -286,7 +310,7 @@ def solve(problem: Problem, steps=10, *, rtol: float = 1e-8, atol: float = 0.0, 
         When a step fails after ``max_cutbacks`` halvings (all carry ``last_converged``).
     """
     opts = NewtonOptions(rtol, atol, energy_tol, max_iter, max_cutbacks, line_search, max_line_search,
-                         linsolve.solver_name(solver), verbose)
+                         linsolve.solver_name(solver), verbose, max_increment)
     if not (isinstance(t0, int | float) and math.isfinite(t0) and t0 >= 0):
         raise ValueError(f"t0 must be a finite load factor >= 0; got {t0!r}")
     factors = _load_factors(steps, t0)

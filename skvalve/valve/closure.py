@@ -52,6 +52,8 @@ class ClosureOptions:
     pressure_start : step time at which the pressure amplitude starts (0.5 in the 1.0 inputs: papillary motion
     first; 0 where everything ramps together, as in the 1.1 healthy input).
     end : last step time (1.5 = end-systole; less for a partial closure).
+    max_increment : cap (mm) on any node's displacement change per Newton iteration (about two thirds of the
+    1.0 leaflets' element size; :func:`~skvalve.fem.newton.solve`).
     insertion : ``"patch"`` spreads each chord's pull over the cells around its insertion (a modelling
     change from the input's point attachment, see :func:`~skvalve.valve.chordae.insertion_patches`), ``"node"``
     keeps the point attachment.
@@ -82,6 +84,7 @@ class ClosureOptions:
     cable_stiffening: tuple[float, float] = (0.4, 0.6)
     pressure_start: float = 0.5
     insertion: str = "patch"
+    max_increment: float | None = 0.5
 
     @classmethod
     def for_model(cls, model: ValveModel, **overrides) -> ClosureOptions:
@@ -202,7 +205,7 @@ def run_closure(setup: ClosureSetup, options: ClosureOptions | None = None, call
                 continue
             solve(setup.problem, steps, rtol=rtol, atol=atol, max_iter=options.max_iter,
                   max_cutbacks=options.max_cutbacks, solver=options.solver, progress=progress, verbose=verbose,
-                  u0=u0, t0=t0, callbacks=stage_callbacks)
+                  u0=u0, t0=t0, callbacks=stage_callbacks, max_increment=options.max_increment)
             u0, t0 = run.u, run.load_factors[-1]
             stage_callbacks = [_AfterStart(callback) for callback in (record, *callbacks)]
     except Exception as err:  # noqa: BLE001 - a failed closure is a result to report, with its last state
