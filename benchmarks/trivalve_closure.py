@@ -20,8 +20,10 @@ from pathlib import Path
 import numpy as np
 
 from skvalve.io.abaqus import read_model, trivalve_input
+from skvalve.papers.mathur2022.figures import write_figures
 from skvalve.valve.closure import ClosureOptions, closure_setup, run_closure, write_log
 from skvalve.valve.model import valve_model
+from skvalve.valve.outputs import ClosureWriter, closure_measures
 
 
 class LastState:
@@ -79,10 +81,23 @@ def main() -> int:
     print(f"wall time {run.seconds:.1f} s, load steps {len(run.load_factors) - 1}, "
           f"Newton iterations {sum(run.iterations)}, contact pairs at the end "
           f"{run.contact_pairs[-1] if run.contact_pairs else 0}, peak memory {run.peak_memory_mb:.0f} MB")
+    print("where the time went (s): " + ", ".join(f"{key} {value:.1f}" for key, value in run.timings.items()))
     print(f"last converged step time {run.load_factors[-1]:.5g} of {options.end}; undamped residual "
           f"(norm, relative) {run.undamped_residual}")
     if run.error:
         print(f"stopped: {run.error}")
+    if run.u is not None:
+        t = run.load_factors[-1]
+        measures = closure_measures(setup, run.u, t)
+        print(f"Table 2-3 measures at step time {t:.5g} (mid surface; mm², kPa): orifice "
+              f"{measures.orifice['mid']:.1f}, leaflets {measures.leaflet_area['mid']:.1f}, coaptation "
+              f"{measures.coaptation_area:.1f}; centre max principal Cauchy stress "
+              + ", ".join(f"{name} {1e3 * value:.2f}" for name, value in measures.centre_stress.items()))
+        ClosureWriter(args.out / "final_state.pvd", setup).write(t, run.u)
+        credit = "Texas TriValve " + ("1.1" if "1.1" in str(path) else "1.0") + " (Mathur et al. 2022), " + \
+                 ("CC BY 4.0" if "1.1" in str(path) else "CC BY-NC-SA 4.0")
+        for figure in write_figures(setup, run.u, t, args.out, credit=credit):
+            print(f"wrote {figure}")
     print(f"trivalve_closure_seconds={run.seconds:.1f}")
     return 0 if run.error is None else 1
 

@@ -128,6 +128,7 @@ class ClosureRun:
     undamped_residual: tuple[float, float] | None = None
     u: np.ndarray | None = None
     error: str | None = None
+    timings: dict[str, float] = field(default_factory=dict)
 
 
 def load_factors(options: ClosureOptions) -> np.ndarray:
@@ -186,7 +187,10 @@ def run_closure(setup: ClosureSetup, options: ClosureOptions | None = None, call
     if u0 is not None and setup.damping is not None:
         setup.damping.committed_u, setup.damping.committed_t = np.array(u0, dtype=float), float(t0)
 
+    stage_timings: dict[int, dict] = {}
+
     def record(event: StepEvent) -> None:
+        stage_timings[id(event.result)] = event.result.timings  # cumulative per solve: setup, assembly, solve
         run.load_factors.append(float(event.load_factor))
         run.iterations.append(len(event.result.histories[-1]))
         run.contact_pairs.append(setup.contact.last_pairs.size if setup.contact.last_pairs is not None else 0)
@@ -212,6 +216,9 @@ def run_closure(setup: ClosureSetup, options: ClosureOptions | None = None, call
         run.error = f"{type(err).__name__}: {err}"
     finally:
         run.peak_memory_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: kB
+        for timings in stage_timings.values():
+            for key, value in timings.items():
+                run.timings[key] = run.timings.get(key, 0.0) + value
         run.seconds = time.perf_counter() - start
     if run.u is not None:
         run.undamped_residual = undamped_residual(setup.problem, run.u, run.load_factors[-1])
@@ -232,6 +239,7 @@ class _AfterStart:
 def write_log(run: ClosureRun, path: Path) -> None:
     """A plain-text summary of the run (atomic write)."""
     lines = [f"seconds {run.seconds:.1f}", f"peak_memory_mb {run.peak_memory_mb:.0f}",
+             "timings " + " ".join(f"{key}={value:.1f}" for key, value in run.timings.items()),
              f"steps {len(run.load_factors) - 1}", f"newton_iterations {sum(run.iterations)}",
              f"last_load_factor {run.load_factors[-1] if run.load_factors else float('nan'):.6g}",
              f"undamped_residual {run.undamped_residual}", f"error {run.error}"]

@@ -3,7 +3,7 @@
 * :mod:`.data` — the paper's numbers (Tables 2, 3, Sect. 2–3) and the TriValve material parameters read from
   the model's Abaqus input (CC BY-NC-SA 4.0, never copied into skvalve).
 * :mod:`.models` — those parameters as skvalve laws (kPa).
-
-``skvalve reproduce mathur2022`` is not available yet (see :mod:`skvalve.papers.registry`): it needs the
-whole-valve model (shells of hexes, trusses, contact) of the valve issues.
+* :mod:`.figures` — the closed valve seen from the atrium, the coaptation map and the orifice outline.
+* :mod:`.reproduce` — ``skvalve reproduce mathur2022``: Table 2 geometry of the open valve by default; with
+  ``--full`` the implicit closure (:mod:`skvalve.valve.closure`) and the Table 2–3 rows at end-systole.
 """
