@@ -45,6 +45,10 @@ def main() -> int:
     parser.add_argument("--verbose", action="store_true", help="one line per Newton iteration")
     parser.add_argument("--resume", action="store_true", help="start from --out/last_state.npz")
     parser.add_argument("--damping", type=float, default=ClosureOptions.damping, help="damping coefficient c0")
+    parser.add_argument("--papillary-steps", type=int, default=ClosureOptions.papillary_steps,
+                        help="nominal load steps of the papillary stage")
+    parser.add_argument("--max-increment", type=float, default=ClosureOptions.max_increment,
+                        help="cap (mm) on a node's displacement change per Newton iteration; 0: none")
     parser.add_argument("--input", type=Path, default=None,
                         help="another TriValve input (.inp; default: the 1.0 diseased valve, $SKVALVE_TRIVALVE)")
     args = parser.parse_args()
@@ -61,7 +65,10 @@ def main() -> int:
         u0, t0 = state["u"], float(state["t"])
         print(f"resuming from step time {t0:.5g}", flush=True)
     model = valve_model(abaqus)
-    overrides = {"damping": args.damping} if args.end is None else {"damping": args.damping, "end": args.end}
+    overrides = {"damping": args.damping, "papillary_steps": args.papillary_steps,
+                 "max_increment": args.max_increment or None}
+    if args.end is not None:
+        overrides["end"] = args.end
     options = ClosureOptions.for_model(model, **overrides)
     print(f"input {Path(path).name}: {options}", flush=True)
     setup = closure_setup(options=options, abaqus=abaqus, model=model)

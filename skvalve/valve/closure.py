@@ -46,14 +46,19 @@ class ClosureOptions:
     """Controls of the closure (units of the input: mm, MPa, s).
 
     penalty : contact penalty (MPa/mm): overlap ~ pressure / (2 penalty) (two-pass).
-    damping : :math:`c_0` of the damping schedule (MPa·s/mm² per unit lumped volume) and ``damping_off``,
-    the step time from which it is zero.
+    damping : :math:`c_0` of the damping schedule (N·s/mm⁴: force per lumped volume and pseudo-velocity) and
+    ``damping_off``, the step time from which it is zero. Keep :math:`c_0 V v` far below what the leaflets carry:
+    the papillary tips move 14 mm in 0.5 (peak pseudo-velocity ~50 mm per unit step time) and drag ~10³ mm³ of
+    leaflet, while a 1 kPa leaflet 0.78 mm thick carries ~10⁻² N across 30 mm; :math:`c_0 = 10^{-3}` gave
+    damping forces of tens of newtons that the chords had to overcome (their exponential law then blew up),
+    :math:`10^{-6}` gives ~0.05 N at the peak and still supports otherwise free nodes.
     papillary_steps, pressure_steps : nominal load steps over 0–``pressure_start`` and ``pressure_start``–``end``.
     pressure_start : step time at which the pressure amplitude starts (0.5 in the 1.0 inputs: papillary motion
     first; 0 where everything ramps together, as in the 1.1 healthy input).
     end : last step time (1.5 = end-systole; less for a partial closure).
-    max_increment : cap (mm) on any node's displacement change per Newton iteration (about two thirds of the
-    1.0 leaflets' element size; :func:`~skvalve.fem.newton.solve`).
+    max_increment : optional cap (mm) on any node's displacement change per Newton iteration
+    (:func:`~skvalve.fem.newton.solve`); off by default: on the 1.0 valve it slowed the papillary stage (each
+    tip step needs the leaflet edges to follow by millimetres) more than it saved in cut-backs.
     insertion : ``"patch"`` spreads each chord's pull over the cells around its insertion (a modelling
     change from the input's point attachment, see :func:`~skvalve.valve.chordae.insertion_patches`), ``"node"``
     keeps the point attachment.
@@ -68,9 +73,9 @@ class ClosureOptions:
     """
 
     penalty: float = 1.0
-    damping: float = 1e-3
+    damping: float = 1e-6
     damping_off: float = 1.25
-    papillary_steps: int = 10
+    papillary_steps: int = 40
     pressure_steps: int = 20
     end: float = 1.5
     max_cutbacks: int = 8
@@ -84,7 +89,7 @@ class ClosureOptions:
     cable_stiffening: tuple[float, float] = (0.4, 0.6)
     pressure_start: float = 0.5
     insertion: str = "patch"
-    max_increment: float | None = 0.5
+    max_increment: float | None = None
 
     @classmethod
     def for_model(cls, model: ValveModel, **overrides) -> ClosureOptions:
