@@ -49,6 +49,8 @@ def main() -> int:
                         help="nominal load steps of the papillary stage")
     parser.add_argument("--max-increment", type=float, default=ClosureOptions.max_increment,
                         help="cap (mm) on a node's displacement change per Newton iteration; 0: none")
+    parser.add_argument("--regularization", type=float, default=ClosureOptions.regularization,
+                        help="initial Levenberg-Marquardt shift of the tangent per step (0: plain Newton)")
     parser.add_argument("--input", type=Path, default=None,
                         help="another TriValve input (.inp; default: the 1.0 diseased valve, $SKVALVE_TRIVALVE)")
     args = parser.parse_args()
@@ -66,7 +68,7 @@ def main() -> int:
         print(f"resuming from step time {t0:.5g}", flush=True)
     model = valve_model(abaqus)
     overrides = {"damping": args.damping, "papillary_steps": args.papillary_steps,
-                 "max_increment": args.max_increment or None}
+                 "max_increment": args.max_increment or None, "regularization": args.regularization}
     if args.end is not None:
         overrides["end"] = args.end
     options = ClosureOptions.for_model(model, **overrides)

@@ -141,3 +141,21 @@ def test_max_increment_caps_the_step_and_reaches_the_same_state():
     assert max(record["largest_increment"] for record in free.histories[1]) > 0.1
     with pytest.raises(ValueError, match="max_increment"):
         solve(build(), steps=1, progress=False, max_increment=-1.0)
+
+
+def test_levenberg_marquardt_shift_keeps_the_equilibrium():
+    """The shift changes the iterates (more, shorter steps at first), not the state converged to."""
+    def build():
+        solid = Solid(skfem.MeshHex().refined(1), NeoHookean(1.0, 10.0))
+        X = solid.space.dof_coordinates
+        solid.add_dirichlet(lambda X: X[0] < 1e-9, 0.0)
+        solid.add_term(NodalForce(solid.space, np.flatnonzero(np.isclose(X[0], 1.0)), [0.0, 0.0, 0.2], ramp=True))
+        return solid
+
+    plain = build().solve(steps=2, progress=False, rtol=1e-11)
+    shifted = solve(build(), steps=2, progress=False, rtol=1e-11, max_iter=60, regularization=1.0)
+    for k in (1, 2):
+        assert np.allclose(shifted.u(k), plain.u(k), rtol=0, atol=1e-10)
+    assert shifted.iterations > plain.iterations
+    with pytest.raises(ValueError, match="regularization"):
+        solve(build(), steps=1, progress=False, regularization=-0.5)

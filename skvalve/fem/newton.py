@@ -41,6 +41,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
 from tqdm.auto import tqdm
 
 from . import linsolve
@@ -54,6 +55,8 @@ logger = logging.getLogger("skvalve.fem")
 
 #: linear solves whose relative residual exceeds this are taken as singular
 _LINEAR_RESIDUAL_LIMIT = 1e-6
+#: Levenberg-Marquardt shifts of the tangent below this are dropped (a full Newton step), above this capped
+_SHIFT_FLOOR, _SHIFT_CEILING = 1e-6, 1e3
 #: a line search that cannot reduce |R| still takes its shortest step, unless |R| grows by more than this factor
 _BLOW_UP = 1e2
 
@@ -76,6 +79,7 @@ class NewtonOptions:
     solver: str = "scipy"
     verbose: bool = False
     max_increment: float | None = None
+    regularization: float = 0.0
     timings: dict = field(default_factory=lambda: {"setup": 0.0, "assembly": 0.0, "solve": 0.0})
 
     def __post_init__(self) -> None:
@@ -90,6 +94,9 @@ class NewtonOptions:
         if self.max_increment is not None and not (isinstance(self.max_increment, int | float)
                                                    and math.isfinite(self.max_increment) and self.max_increment > 0):
             raise ValueError(f"max_increment must be None or a positive finite length; got {self.max_increment!r}")
+        if not (isinstance(self.regularization, int | float) and math.isfinite(self.regularization)
+                and self.regularization >= 0):
+            raise ValueError(f"regularization must be a finite number >= 0; got {self.regularization!r}")
         for name, low in (("max_iter", 1), ("max_cutbacks", 0), ("max_line_search", 0)):
             value = getattr(self, name)
             if not isinstance(value, int | np.integer) or isinstance(value, bool) or value < low:
@@ -166,9 +173,12 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
     if not moved and norm <= max(opts.rtol * reference, opts.atol):
         return u, residual, history, tangent
     energy0, last_error = None, None
+    shift = opts.regularization
     for iteration in range(1, opts.max_iter + 1):
         start = time.perf_counter()
         K = problem.tangent_matrix(tangent)
+        if shift >= _SHIFT_FLOOR:
+            K = K + sp.diags(shift * np.abs(K.diagonal()), format="csr")
         opts.timings["assembly"] += time.perf_counter() - start
         try:
             du_free = _linear_solve(problem, K, -rhs[free], opts)
@@ -181,6 +191,7 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
         energy = abs(du_free @ rhs[free])
         energy0 = energy if energy0 is None else energy0
         alpha, accepted = _capped_length(problem, du, opts.max_increment), None
+        first_length = alpha
         shortest = alpha * 2.0 ** -opts.max_line_search * 1.5
         baseline = norm
         if moved and iteration == 1 and opts.line_search:
@@ -214,6 +225,8 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
         if accepted is None:
             raise _StepFailed(str(last_error)) from last_error
         u, residual, tangent, norm = accepted
+        if opts.regularization > 0.0:  # Levenberg-Marquardt: relax after a full step, tighten after a short one
+            shift = shift * 0.25 if alpha >= first_length else min(4.0 * max(shift, _SHIFT_FLOOR), _SHIFT_CEILING)
         rhs = residual
         reference = _reference(problem, residual, fixed)
         relative = norm / reference
@@ -279,8 +292,8 @@ def solve(problem: Problem, steps=10, *, rtol: float = 1e-8, atol: float = 0.0, 
           max_iter: int = 25, max_cutbacks: int = 6, line_search: bool = True, max_line_search: int = 4,
           solver: str | None = None, progress: bool = True, verbose: bool = False, u0: np.ndarray | None = None,
           t0: float = 0.0, callbacks: Sequence[Callable[[StepEvent], None]] = (),
-          max_increment: float | None = None) -> Result:
-    """Solve the load path ``t`` in ``steps`` (int: uniform steps to 1; or increasing factors).
+          max_increment: float | None = None, regularization: float = 0.0) -> Result:
+    r"""Solve the load path ``t`` in ``steps`` (int: uniform steps to 1; or increasing factors).
 
     Parameters
     ----------
@@ -298,6 +311,11 @@ def solve(problem: Problem, steps=10, *, rtol: float = 1e-8, atol: float = 0.0, 
     max_increment : optional cap (length units) on any node's displacement change in one iteration: the line
         search starts from the step length that meets it (a trust region against Newton steps thrown far by
         nearly free directions, e.g. cable branch points between slack and taut).
+    regularization : initial Levenberg–Marquardt shift :math:`\mu` of each step: the iterations solve
+        :math:`(K_{ff} + \mu\,|\mathrm{diag}\,K_{ff}|)\,\Delta u = -R_f`, with :math:`\mu` divided by 4 after a
+        full-length step and multiplied by 4 after a shortened one (dropped below 1e-6). It changes the path of the
+        iterates, not the equilibrium solved for: a step through a buckling or wrinkling leaflet, where
+        :math:`K_{ff}` is indefinite, gets descent directions instead of steps thrown along the unstable mode.
 
     Returns
     -------
@@ -310,7 +328,7 @@ def solve(problem: Problem, steps=10, *, rtol: float = 1e-8, atol: float = 0.0, 
         When a step fails after ``max_cutbacks`` halvings (all carry ``last_converged``).
     """
     opts = NewtonOptions(rtol, atol, energy_tol, max_iter, max_cutbacks, line_search, max_line_search,
-                         linsolve.solver_name(solver), verbose, max_increment)
+                         linsolve.solver_name(solver), verbose, max_increment, regularization)
     if not (isinstance(t0, int | float) and math.isfinite(t0) and t0 >= 0):
         raise ValueError(f"t0 must be a finite load factor >= 0; got {t0!r}")
     factors = _load_factors(steps, t0)

@@ -59,6 +59,7 @@ class ClosureOptions:
     max_increment : optional cap (mm) on any node's displacement change per Newton iteration
     (:func:`~skvalve.fem.newton.solve`); off by default: on the 1.0 valve it slowed the papillary stage (each
     tip step needs the leaflet edges to follow by millimetres) more than it saved in cut-backs.
+    regularization : initial Levenberg–Marquardt shift of the tangent in each step (:func:`~skvalve.fem.newton.solve`).
     insertion : ``"patch"`` spreads each chord's pull over the cells around its insertion (a modelling
     change from the input's point attachment, see :func:`~skvalve.valve.chordae.insertion_patches`), ``"node"``
     keeps the point attachment.
@@ -90,6 +91,7 @@ class ClosureOptions:
     pressure_start: float = 0.5
     insertion: str = "patch"
     max_increment: float | None = None
+    regularization: float = 0.0
 
     @classmethod
     def for_model(cls, model: ValveModel, **overrides) -> ClosureOptions:
@@ -214,7 +216,8 @@ def run_closure(setup: ClosureSetup, options: ClosureOptions | None = None, call
                 continue
             solve(setup.problem, steps, rtol=rtol, atol=atol, max_iter=options.max_iter,
                   max_cutbacks=options.max_cutbacks, solver=options.solver, progress=progress, verbose=verbose,
-                  u0=u0, t0=t0, callbacks=stage_callbacks, max_increment=options.max_increment)
+                  u0=u0, t0=t0, callbacks=stage_callbacks, max_increment=options.max_increment,
+                  regularization=options.regularization)
             u0, t0 = run.u, run.load_factors[-1]
             stage_callbacks = [_AfterStart(callback) for callback in (record, *callbacks)]
     except Exception as err:  # noqa: BLE001 - a failed closure is a result to report, with its last state
