@@ -60,6 +60,9 @@ class ClosureOptions:
     (:func:`~skvalve.fem.newton.solve`); off by default: on the 1.0 valve it slowed the papillary stage (each
     tip step needs the leaflet edges to follow by millimetres) more than it saved in cut-backs.
     regularization : initial Levenberg–Marquardt shift of the tangent in each step (:func:`~skvalve.fem.newton.solve`).
+    contact_from : step time from which the contact penalty acts (the pressure's start by :meth:`for_model`): in the
+    papillary stage the chords pull the leaflets apart, and the few pairs that folds of one leaflet make there
+    (1–7 on the 1.0 valve) switched on and off between iterates and stalled Newton.
     insertion : ``"patch"`` spreads each chord's pull over the cells around its insertion (a modelling
     change from the input's point attachment, see :func:`~skvalve.valve.chordae.insertion_patches`), ``"node"``
     keeps the point attachment.
@@ -92,6 +95,7 @@ class ClosureOptions:
     insertion: str = "patch"
     max_increment: float | None = None
     regularization: float = 0.0
+    contact_from: float = 0.5
 
     @classmethod
     def for_model(cls, model: ValveModel, **overrides) -> ClosureOptions:
@@ -101,7 +105,7 @@ class ClosureOptions:
         starts = [float(p.amplitude.times[0]) for p in model.pressures if p.amplitude is not None]
         pressure_start = min(starts) if starts else 0.0
         end = float(model.end_time)
-        fitted = {"end": end, "pressure_start": pressure_start,
+        fitted = {"end": end, "pressure_start": pressure_start, "contact_from": pressure_start,
                   "damping_off": pressure_start + 0.75 * (end - pressure_start)}
         if pressure_start > 0.0:
             fitted["cable_stiffening"] = (0.8 * pressure_start, min(1.2 * pressure_start, end))
@@ -171,7 +175,8 @@ def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: Abaq
     # quarter of the thinnest stack keeps them from pairing (bricks: the contact term's default depth)
     thinnest = thinnest_stack(model, abaqus)
     depth = None if thinnest is None else 0.25 * thinnest
-    contact = problem.add_term(SurfaceContact(problem.space, surface, options.penalty, max_penetration=depth))
+    penalty = options.penalty if options.contact_from <= 0.0 else _PenaltyFrom(options.penalty, options.contact_from)
+    contact = problem.add_term(SurfaceContact(problem.space, surface, penalty, max_penetration=depth))
     damping = None
     if options.damping > 0.0:
         damping = problem.add_term(ViscousDamping(problem.space, DampingSchedule(options.damping,
@@ -231,6 +236,17 @@ def run_closure(setup: ClosureSetup, options: ClosureOptions | None = None, call
     if run.u is not None:
         run.undamped_residual = undamped_residual(setup.problem, run.u, run.load_factors[-1])
     return run
+
+
+@dataclass(frozen=True)
+class _PenaltyFrom:
+    """Contact penalty ``value`` from step time ``start`` on, zero before."""
+
+    value: float
+    start: float
+
+    def __call__(self, t: float) -> float:
+        return self.value if t >= self.start else 0.0
 
 
 class _AfterStart:
