@@ -51,6 +51,8 @@ def main() -> int:
                         help="cap (mm) on a node's displacement change per Newton iteration; 0: none")
     parser.add_argument("--regularization", type=float, default=ClosureOptions.regularization,
                         help="initial Levenberg-Marquardt shift of the tangent per step (0: plain Newton)")
+    parser.add_argument("--cable-softening", type=float, default=None,
+                        help="initial scale of the chordae's taut law (1: none; default from the input's staging)")
     parser.add_argument("--input", type=Path, default=None,
                         help="another TriValve input (.inp; default: the 1.0 diseased valve, $SKVALVE_TRIVALVE)")
     args = parser.parse_args()
@@ -71,6 +73,8 @@ def main() -> int:
                  "max_increment": args.max_increment or None, "regularization": args.regularization}
     if args.end is not None:
         overrides["end"] = args.end
+    if args.cable_softening is not None:
+        overrides["cable_softening"] = args.cable_softening
     options = ClosureOptions.for_model(model, **overrides)
     print(f"input {Path(path).name}: {options}", flush=True)
     setup = closure_setup(options=options, abaqus=abaqus, model=model)

@@ -119,19 +119,21 @@ def test_stiffness_scale_softens_the_taut_law_and_keeps_the_slack_spring():
     assert force == pytest.approx(0.5 * k * (1.9 / 2.2 - 2.0 / 2.2), rel=1e-12)
 
 
+def _cantilever(tip_force: float) -> Solid:
+    """A unit block (2x2x2 hexes) clamped at x = 0 with a ramped transverse load on its face x = 1."""
+    solid = Solid(skfem.MeshHex().refined(1), NeoHookean(1.0, 10.0))
+    X = solid.space.dof_coordinates
+    solid.add_dirichlet(lambda X: X[0] < 1e-9, 0.0)
+    solid.add_term(NodalForce(solid.space, np.flatnonzero(np.isclose(X[0], 1.0)), [0.0, 0.0, tip_force], ramp=True))
+    return solid
+
+
 def test_max_increment_caps_the_step_and_reaches_the_same_state():
     """A cantilever block under a large tip load: uncapped Newton moves some node more than 0.1 in one
     iteration; with max_increment = 0.05 every accepted iterate moves no node further than that, more iterations are
     needed, and the converged state is the same."""
-    def build():
-        solid = Solid(skfem.MeshHex().refined(1), NeoHookean(1.0, 10.0))
-        X = solid.space.dof_coordinates
-        solid.add_dirichlet(lambda X: X[0] < 1e-9, 0.0)
-        solid.add_term(NodalForce(solid.space, np.flatnonzero(np.isclose(X[0], 1.0)), [0.0, 0.0, 0.05], ramp=True))
-        return solid
-
-    free = build().solve(steps=1, progress=False, rtol=1e-10)
-    capped = solve(build(), steps=1, progress=False, rtol=1e-10, max_iter=60, max_increment=0.05)
+    free = _cantilever(0.05).solve(steps=1, progress=False, rtol=1e-10)
+    capped = solve(_cantilever(0.05), steps=1, progress=False, rtol=1e-10, max_iter=60, max_increment=0.05)
     assert np.allclose(capped.u(), free.u(), rtol=0, atol=1e-9)
     assert capped.iterations > free.iterations
     assert np.linalg.norm(free.u().reshape(-1, 3), axis=1).max() > 0.3  # the cap had work to do
@@ -140,22 +142,15 @@ def test_max_increment_caps_the_step_and_reaches_the_same_state():
     assert max(record["largest_increment"] for record in capped.histories[1]) <= 0.05 * (1 + 1e-12)
     assert max(record["largest_increment"] for record in free.histories[1]) > 0.1
     with pytest.raises(ValueError, match="max_increment"):
-        solve(build(), steps=1, progress=False, max_increment=-1.0)
+        solve(_cantilever(0.05), steps=1, progress=False, max_increment=-1.0)
 
 
 def test_levenberg_marquardt_shift_keeps_the_equilibrium():
     """The shift changes the iterates (more, shorter steps at first), not the state converged to."""
-    def build():
-        solid = Solid(skfem.MeshHex().refined(1), NeoHookean(1.0, 10.0))
-        X = solid.space.dof_coordinates
-        solid.add_dirichlet(lambda X: X[0] < 1e-9, 0.0)
-        solid.add_term(NodalForce(solid.space, np.flatnonzero(np.isclose(X[0], 1.0)), [0.0, 0.0, 0.2], ramp=True))
-        return solid
-
-    plain = build().solve(steps=2, progress=False, rtol=1e-11)
-    shifted = solve(build(), steps=2, progress=False, rtol=1e-11, max_iter=60, regularization=1.0)
+    plain = _cantilever(0.2).solve(steps=2, progress=False, rtol=1e-11)
+    shifted = solve(_cantilever(0.2), steps=2, progress=False, rtol=1e-11, max_iter=60, regularization=1.0)
     for k in (1, 2):
         assert np.allclose(shifted.u(k), plain.u(k), rtol=0, atol=1e-10)
     assert shifted.iterations > plain.iterations
     with pytest.raises(ValueError, match="regularization"):
-        solve(build(), steps=1, progress=False, regularization=-0.5)
+        solve(_cantilever(0.2), steps=1, progress=False, regularization=-0.5)
