@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -53,6 +54,10 @@ def main() -> int:
                         help="initial Levenberg-Marquardt shift of the tangent per step (0: plain Newton)")
     parser.add_argument("--cable-softening", type=float, default=None,
                         help="initial scale of the chordae's taut law (1: none; default from the input's staging)")
+    parser.add_argument("--hold-papillary", action="store_true",
+                        help="a variant: papillary tips held where they are (no tethering), pressure stage only")
+    parser.add_argument("--pressure-damping", type=float, default=ClosureOptions.pressure_damping,
+                        help="damping coefficient of the pressure stage (decays to 0 at damping_off)")
     parser.add_argument("--input", type=Path, default=None,
                         help="another TriValve input (.inp; default: the 1.0 diseased valve, $SKVALVE_TRIVALVE)")
     args = parser.parse_args()
@@ -69,7 +74,13 @@ def main() -> int:
         u0, t0 = state["u"], float(state["t"])
         print(f"resuming from step time {t0:.5g}", flush=True)
     model = valve_model(abaqus)
+    if args.hold_papillary:  # the conditions that start moving before the pressure: the papillary tips
+        pressure_start = ClosureOptions.for_model(model).pressure_start
+        model.conditions = [replace(c, value=0.0) if c.amplitude is not None and c.amplitude.times[0] < pressure_start
+                            and c.value != 0.0 else c for c in model.conditions]
+        print("variant: papillary tips held in place (no tethering)", flush=True)
     overrides = {"damping": args.damping, "papillary_steps": args.papillary_steps,
+                 "pressure_damping": args.pressure_damping,
                  "max_increment": args.max_increment or None, "regularization": args.regularization}
     if args.end is not None:
         overrides["end"] = args.end

@@ -158,3 +158,14 @@ def test_options_fitted_to_the_staging_of_an_input():
     assert fitted == (1.0, 0.0, 0.75, 1.0)
     np.testing.assert_allclose(load_factors(together), [0.25, 0.5, 0.75, 1.0])
     assert ClosureOptions.for_model(stub(0.0, 1.0), damping=0.0).damping == 0.0  # overrides win
+
+
+def test_staged_damping_schedule():
+    """Papillary value before the pressure starts, then c_p (1 - tau)^2 down to zero at t_off."""
+    from skvalve.valve.closure import StagedDamping
+
+    schedule = StagedDamping(1e-6, 1e-4, 0.5, 1.25)
+    assert schedule(0.0) == schedule(0.49) == 1e-6
+    assert schedule(0.5) == 1e-4
+    assert schedule(0.875) == pytest.approx(1e-4 * 0.25, rel=1e-14)
+    assert schedule(1.25) == schedule(1.5) == 0.0

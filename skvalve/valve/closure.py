@@ -28,7 +28,7 @@ import numpy as np
 
 from ..fem.amplitudes import GeometricRamp
 from ..fem.contact import SurfaceContact
-from ..fem.damping import DampingSchedule, ViscousDamping, undamped_residual
+from ..fem.damping import ViscousDamping, undamped_residual
 from ..fem.newton import StepEvent, solve
 from ..fem.problem import Problem
 from ..fem.truss import Truss
@@ -36,8 +36,8 @@ from ..io.abaqus import AbaqusModel, read_model, trivalve_input
 from .model import ValveModel, valve_model
 from .surfaces import contact_surface, thinnest_stack
 
-__all__ = ["ClosureOptions", "ClosureSetup", "ClosureRun", "closure_setup", "contact_surface", "load_factors",
-           "run_closure"]
+__all__ = ["ClosureOptions", "ClosureSetup", "ClosureRun", "StagedDamping", "closure_setup", "contact_surface",
+           "load_factors", "run_closure"]
 
 
 
@@ -60,6 +60,9 @@ class ClosureOptions:
     (:func:`~skvalve.fem.newton.solve`); off by default: on the 1.0 valve it slowed the papillary stage (each
     tip step needs the leaflet edges to follow by millimetres) more than it saved in cut-backs.
     regularization : initial Levenberg–Marquardt shift of the tangent in each step (:func:`~skvalve.fem.newton.solve`).
+    pressure_damping : :math:`c_0` from ``pressure_start`` on, decaying to zero at ``damping_off``
+    (:class:`StagedDamping`): the leaflets under the first, tiny pressures are nearly free, and nothing prescribed
+    drags them there, so they take far more damping than the papillary stage does.
     contact_from : step time from which the contact penalty acts (the pressure's start by :meth:`for_model`): in the
     papillary stage the chords pull the leaflets apart, and the few pairs that folds of one leaflet make there
     (1–7 on the 1.0 valve) switched on and off between iterates and stalled Newton.
@@ -96,6 +99,7 @@ class ClosureOptions:
     max_increment: float | None = None
     regularization: float = 0.0
     contact_from: float = 0.5
+    pressure_damping: float = 1e-4
 
     @classmethod
     def for_model(cls, model: ValveModel, **overrides) -> ClosureOptions:
@@ -179,8 +183,9 @@ def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: Abaq
     contact = problem.add_term(SurfaceContact(problem.space, surface, penalty, max_penetration=depth))
     damping = None
     if options.damping > 0.0:
-        damping = problem.add_term(ViscousDamping(problem.space, DampingSchedule(options.damping,
-                                                                                   options.damping_off)))
+        schedule = StagedDamping(options.damping, options.pressure_damping, options.pressure_start,
+                                 options.damping_off)
+        damping = problem.add_term(ViscousDamping(problem.space, schedule))
     leaflet = np.full(model.mesh.p.shape[1], -1, dtype=np.int64)
     leaflet[model.mesh.t] = model.regions[None, :]
     return ClosureSetup(abaqus, model, problem, contact, damping, leaflet)
@@ -236,6 +241,24 @@ def run_closure(setup: ClosureSetup, options: ClosureOptions | None = None, call
     if run.u is not None:
         run.undamped_residual = undamped_residual(setup.problem, run.u, run.load_factors[-1])
     return run
+
+
+@dataclass(frozen=True)
+class StagedDamping:
+    r"""Damping coefficient of the two stages: ``papillary`` before ``pressure_start``, then
+    :math:`c_p\,(1 - \tau)^2` with :math:`\tau = (t - t_p)/(t_\text{off} - t_p)`, zero from ``t_off`` on."""
+
+    papillary: float
+    pressure: float
+    pressure_start: float
+    t_off: float
+
+    def __call__(self, t: float) -> float:
+        if t < self.pressure_start:
+            return self.papillary
+        if t >= self.t_off:
+            return 0.0
+        return self.pressure * (1.0 - (t - self.pressure_start) / (self.t_off - self.pressure_start)) ** 2
 
 
 @dataclass(frozen=True)
