@@ -428,7 +428,7 @@ if HAVE_DATA:
 # = 3 kPa), tighten one by one as the tips descend and tug single free-edge nodes of a leaflet that has no load yet to
 # hold its shape: with the chords at full stiffness Newton converges only linearly (line-search steps of ½) and longer
 # steps invert the hexes next to the insertions before the leaflet follows. The full closure (`skvalve.valve.closure`)
-# therefore uses a **continuation**: the chords start with their law scaled by $s_0 = 10^{-3}$ (still over 25 times
+# therefore uses a **continuation**: the chords start with their taut law scaled by $s_0 = 10^{-3}$ (still over 25 times
 # stiffer than the leaflet) and regain it geometrically, $s(t) = s_0^{\,1 - S(\xi)}$ with the smooth step $S$ over
 # $0.4 \le t \le 0.6$ (`GeometricRamp`), before the pressure rises. The chapter does the same and stops at **step time
 # 0.25**: the papillary tips 7 mm down (half their way), no pressure yet, in five nominal steps with an absolute force
@@ -460,13 +460,15 @@ if HAVE_DATA:
 # **Checks of the solved state.** (i) The tips sit where the amplitude puts them: $-14\,\text{mm}\times s(\xi)$ with
 # $\xi = t/0.5$ and the quintic $s$ by hand. (ii) Equilibrium of the papillary tips: no hex and no damping mass
 # touches a tip, so the solver's residual there (the reaction) must equal the sum of the forces of the cables ending
-# there, recomputed by hand from the current node positions — $N = A\,[k_s(\lambda-\lambda_s) + w(\lambda)
-# P_\text{Ogden}(\lambda)]$ times the continuation scale $s(t)$, with $\lambda$ = current length / rest length, the
+# there, recomputed by hand from the current node positions — $N = A\,[k_s(\lambda-\lambda_s) + s(t)\,w(\lambda)
+# P_\text{Ogden}(\lambda)]$ with the continuation scale $s(t)$ on the taut law only (the slack spring keeps the
+# ends of slack cables supported), $\lambda$ = current length / rest length, the
 # smooth switch $w$ of `TensionOnly` and the Ogden closed form of Sect. 1. This checks the cable kinematics, law,
 # continuation scale and assembly independently of the `Truss` code. The resultant is the force with which the
 # papillary muscles hold the posterior leaflet at this stage.
 # %%
-def cable_forces(x, ends, rest_length, area, laws, law_index, slack_stretch, slack_fraction=1e-6, transition=0.01):
+def cable_forces(x, ends, rest_length, area, laws, law_index, slack_stretch, scale, slack_fraction=1e-6,
+                 transition=0.01):
     """Axial force vectors on the first end of each cable (N), by hand."""
     d = x[ends[:, 1]] - x[ends[:, 0]]
     length = np.linalg.norm(d, axis=1)
@@ -478,7 +480,7 @@ def cable_forces(x, ends, rest_length, area, laws, law_index, slack_stretch, sla
         ogden = sum(2 * m / a * (lam ** (a - 1) - lam ** (-a / 2 - 1)) for m, a in zip(law.mu, law.alpha, strict=True))
         z = np.clip((stretch[mine] - 1.0) / transition, 0.0, 1.0)
         slack = slack_fraction * 3 * sum(law.mu)
-        P[mine] = slack * (stretch[mine] - slack_stretch[mine]) + z**2 * (3 - 2 * z) * ogden
+        P[mine] = slack * (stretch[mine] - slack_stretch[mine]) + scale * z**2 * (3 - 2 * z) * ogden
     return (area * P / length)[:, None] * d, stretch
 
 
@@ -491,10 +493,10 @@ if HAVE_DATA:
         assert abs(by_hand + 7.0) < 1e-12
     x = mesh.p.T + u_nodes
     ends = renumber[chordae.ends[kept]]
-    force, stretch = cable_forces(x, ends, chordae.rest_length[kept], chordae.area[kept], chordae.laws,
-                                  chordae.law_index[kept], chordae.slack_stretch[kept])
     eta = np.clip((t_end - 0.4) / 0.2, 0.0, 1.0)
-    force *= 1e-3 ** (1.0 - eta**3 * (10 - 15 * eta + 6 * eta**2))  # the continuation scale s(t), by hand
+    scale = 1e-3 ** (1.0 - eta**3 * (10 - 15 * eta + 6 * eta**2))  # the continuation scale s(t), by hand
+    force, stretch = cable_forces(x, ends, chordae.rest_length[kept], chordae.area[kept], chordae.laws,
+                                  chordae.law_index[kept], chordae.slack_stretch[kept], scale)
     on_tips = np.zeros((tips.size, 3))
     for end, sign in ((0, -1.0), (1, 1.0)):  # internal force: -N e at the first end, +N e at the second
         at_tip = np.isin(ends[:, end], tips)
