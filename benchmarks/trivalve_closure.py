@@ -58,6 +58,8 @@ def main() -> int:
                         help="a variant: papillary tips held where they are (no tethering), pressure stage only")
     parser.add_argument("--pressure-damping", type=float, default=ClosureOptions.pressure_damping,
                         help="damping coefficient of the pressure stage (decays to 0 at damping_off)")
+    parser.add_argument("--path-atol", type=float, default=ClosureOptions.path_atol,
+                        help="absolute residual tolerance (N) of the damped steps")
     parser.add_argument("--input", type=Path, default=None,
                         help="another TriValve input (.inp; default: the 1.0 diseased valve, $SKVALVE_TRIVALVE)")
     args = parser.parse_args()
@@ -80,7 +82,7 @@ def main() -> int:
                             and c.value != 0.0 else c for c in model.conditions]
         print("variant: papillary tips held in place (no tethering)", flush=True)
     overrides = {"damping": args.damping, "papillary_steps": args.papillary_steps,
-                 "pressure_damping": args.pressure_damping,
+                 "pressure_damping": args.pressure_damping, "path_atol": args.path_atol,
                  "max_increment": args.max_increment or None, "regularization": args.regularization}
     if args.end is not None:
         overrides["end"] = args.end
