@@ -169,3 +169,18 @@ def test_staged_damping_schedule():
     assert schedule(0.5) == 1e-4
     assert schedule(0.875) == pytest.approx(1e-4 * 0.25, rel=1e-14)
     assert schedule(1.25) == schedule(1.5) == 0.0
+
+
+def test_damping_weights_give_nodes_outside_every_cell_the_median_volume():
+    """Two unit hexes and a vertex no cell uses (a chordae branch point): the cell nodes keep their lumped
+    volumes (1/8 per cell), the bare node gets the median of those."""
+    from skvalve.valve.closure import damping_weights
+
+    mesh = skfem.MeshHex.init_tensor(np.linspace(0, 2, 3), np.linspace(0, 1, 2), np.linspace(0, 1, 2))
+    p = np.hstack([[[5.0], [5.0], [5.0]], mesh.p])  # vertex 0 in no cell
+    space = Space(skfem.MeshHex(p, mesh.t + 1))
+    weights = damping_weights(space)[: space.n_u].reshape(-1, 3)
+    assert np.allclose(weights[:, 0], weights[:, 2])
+    nodal = weights[1:, 0]
+    assert np.allclose(np.sort(nodal), [0.125] * 8 + [0.25] * 4)  # corners of one cell / shared by two
+    assert weights[0, 0] == pytest.approx(np.median(nodal))

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..fem.amplitudes import GeometricRamp
 from ..fem.contact import SurfaceContact
-from ..fem.damping import ViscousDamping, undamped_residual
+from ..fem.damping import ViscousDamping, lumped_volume, undamped_residual
 from ..fem.newton import StepEvent, solve
 from ..fem.problem import Problem
 from ..fem.truss import Truss
@@ -37,7 +37,7 @@ from .model import ValveModel, valve_model
 from .surfaces import contact_surface, thinnest_stack
 
 __all__ = ["ClosureOptions", "ClosureSetup", "ClosureRun", "StagedDamping", "closure_setup", "contact_surface",
-           "load_factors", "run_closure"]
+           "damping_weights", "load_factors", "run_closure"]
 
 
 
@@ -185,7 +185,7 @@ def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: Abaq
     if options.damping > 0.0:
         schedule = StagedDamping(options.damping, options.pressure_damping, options.pressure_start,
                                  options.damping_off)
-        damping = problem.add_term(ViscousDamping(problem.space, schedule))
+        damping = problem.add_term(ViscousDamping(problem.space, schedule, weighting=damping_weights(problem.space)))
     leaflet = np.full(model.mesh.p.shape[1], -1, dtype=np.int64)
     leaflet[model.mesh.t] = model.regions[None, :]
     return ClosureSetup(abaqus, model, problem, contact, damping, leaflet)
@@ -241,6 +241,18 @@ def run_closure(setup: ClosureSetup, options: ClosureOptions | None = None, call
     if run.u is not None:
         run.undamped_residual = undamped_residual(setup.problem, run.u, run.load_factors[-1])
     return run
+
+
+def damping_weights(space) -> np.ndarray:
+    """Lumped nodal volumes, with the nodes of no leaflet cell (chordae branch points) given the median nodal
+    volume: a branch point whose cables are all slack has only their slack springs, and without damping Newton
+    threw such points by tens of millimetres per iteration."""
+    weights = lumped_volume(space)
+    displacement = weights[: space.n_u]
+    bare = displacement == 0.0
+    if np.any(bare) and np.any(~bare):
+        displacement[bare] = np.median(displacement[~bare])
+    return weights
 
 
 @dataclass(frozen=True)
