@@ -21,10 +21,22 @@ from pathlib import Path
 import numpy as np
 
 from skvalve.io.abaqus import read_model, trivalve_input
+from skvalve.io.files import replace_atomically
 from skvalve.papers.mathur2022.figures import write_figures
 from skvalve.valve.closure import ClosureOptions, closure_setup, run_closure, write_log
 from skvalve.valve.model import valve_model
 from skvalve.valve.outputs import ClosureWriter, closure_measures
+
+#: flags that override a ClosureOptions field of the same name: type and help
+OPTION_FLAGS = {
+    "damping": (float, "damping coefficient c0 of the papillary stage"),
+    "pressure_damping": (float, "damping coefficient of the pressure stage (decays to 0 at damping_off)"),
+    "papillary_steps": (int, "nominal load steps of the papillary stage"),
+    "path_atol": (float, "absolute residual tolerance (N) of the damped steps"),
+    "max_increment": (float, "cap (mm) on a node's displacement change per Newton iteration; 0: none"),
+    "regularization": (float, "initial Levenberg-Marquardt shift of the tangent per step (0: plain Newton)"),
+    "cable_softening": (float, "initial scale of the chordae's taut law (1: none)"),
+}
 
 
 class LastState:
@@ -34,9 +46,7 @@ class LastState:
         self.path = folder / "last_state.npz"
 
     def __call__(self, event) -> None:
-        temporary = self.path.with_name(".last_state.tmp.npz")
-        np.savez(temporary, t=event.load_factor, u=event.u)
-        temporary.replace(self.path)
+        replace_atomically(self.path, lambda temporary: np.savez(temporary, t=event.load_factor, u=event.u))
 
 
 def main() -> int:
@@ -45,21 +55,11 @@ def main() -> int:
     parser.add_argument("--end", type=float, default=None, help="last step time (default: the input's step time)")
     parser.add_argument("--verbose", action="store_true", help="one line per Newton iteration")
     parser.add_argument("--resume", action="store_true", help="start from --out/last_state.npz")
-    parser.add_argument("--damping", type=float, default=ClosureOptions.damping, help="damping coefficient c0")
-    parser.add_argument("--papillary-steps", type=int, default=ClosureOptions.papillary_steps,
-                        help="nominal load steps of the papillary stage")
-    parser.add_argument("--max-increment", type=float, default=ClosureOptions.max_increment,
-                        help="cap (mm) on a node's displacement change per Newton iteration; 0: none")
-    parser.add_argument("--regularization", type=float, default=ClosureOptions.regularization,
-                        help="initial Levenberg-Marquardt shift of the tangent per step (0: plain Newton)")
-    parser.add_argument("--cable-softening", type=float, default=None,
-                        help="initial scale of the chordae's taut law (1: none; default from the input's staging)")
+    for name, (kind, text) in OPTION_FLAGS.items():
+        parser.add_argument("--" + name.replace("_", "-"), type=kind, default=None,
+                            help=f"{text} (default: ClosureOptions.for_model)")
     parser.add_argument("--hold-papillary", action="store_true",
                         help="a variant: papillary tips held where they are (no tethering), pressure stage only")
-    parser.add_argument("--pressure-damping", type=float, default=ClosureOptions.pressure_damping,
-                        help="damping coefficient of the pressure stage (decays to 0 at damping_off)")
-    parser.add_argument("--path-atol", type=float, default=ClosureOptions.path_atol,
-                        help="absolute residual tolerance (N) of the damped steps")
     parser.add_argument("--input", type=Path, default=None,
                         help="another TriValve input (.inp; default: the 1.0 diseased valve, $SKVALVE_TRIVALVE)")
     args = parser.parse_args()
@@ -81,13 +81,9 @@ def main() -> int:
         model.conditions = [replace(c, value=0.0) if c.amplitude is not None and c.amplitude.times[0] < pressure_start
                             and c.value != 0.0 else c for c in model.conditions]
         print("variant: papillary tips held in place (no tethering)", flush=True)
-    overrides = {"damping": args.damping, "papillary_steps": args.papillary_steps,
-                 "pressure_damping": args.pressure_damping, "path_atol": args.path_atol,
-                 "max_increment": args.max_increment or None, "regularization": args.regularization}
-    if args.end is not None:
-        overrides["end"] = args.end
-    if args.cable_softening is not None:
-        overrides["cable_softening"] = args.cable_softening
+    overrides = {name: getattr(args, name) for name in ("end", *OPTION_FLAGS) if getattr(args, name) is not None}
+    if overrides.get("max_increment") == 0.0:
+        overrides["max_increment"] = None
     options = ClosureOptions.for_model(model, **overrides)
     print(f"input {Path(path).name}: {options}", flush=True)
     setup = closure_setup(options=options, abaqus=abaqus, model=model)

@@ -190,8 +190,9 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
         du[free] = du_free
         energy = abs(du_free @ rhs[free])
         energy0 = energy if energy0 is None else energy0
-        alpha, accepted = _capped_length(problem, du, opts.max_increment), None
-        first_length = alpha
+        largest = _largest_nodal(problem, du)
+        alpha = 1.0 if opts.max_increment is None or largest <= opts.max_increment else opts.max_increment / largest
+        first_length, accepted = alpha, None
         shortest = alpha * 2.0 ** -opts.max_line_search * 1.5
         baseline = norm
         if moved and iteration == 1 and opts.line_search:
@@ -234,7 +235,7 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
         record = {"step": step, "load_factor": t_new, "iteration": iteration, "residual": norm,
                   "relative_residual": relative, "increment": float(np.linalg.norm(alpha * du_free)),
                   "relative_energy": relative_energy, "alpha": alpha,
-                  "largest_increment": alpha * _largest_nodal(problem, du)}
+                  "largest_increment": alpha * largest}
         history.append(record)
         logger.info("step %d t=%.4g it %d |R|=%.3e rel=%.3e |du|=%.3e energy=%.3e alpha=%.3g", step, t_new,
                     iteration, norm, relative, record["increment"], relative_energy, alpha)
@@ -253,14 +254,6 @@ def _largest_nodal(problem: Problem, du: np.ndarray) -> float:
     """The largest nodal displacement change in ``du``."""
     space = problem.space
     return float(np.max(np.linalg.norm(du[: space.n_u].reshape(-1, space.dim), axis=1), initial=0.0))
-
-
-def _capped_length(problem: Problem, du: np.ndarray, max_increment: float | None) -> float:
-    """The first line-search length: 1, or less so that no node moves more than ``max_increment``."""
-    if max_increment is None:
-        return 1.0
-    largest = _largest_nodal(problem, du)
-    return 1.0 if largest <= max_increment else max_increment / largest
 
 
 def _true_residual(problem: Problem, u: np.ndarray, t: float, step: int, free: np.ndarray,

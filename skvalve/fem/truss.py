@@ -174,7 +174,8 @@ class Truss(Term):
         self.n_bars = self.nodes.shape[0]
         self.dofs = np.ascontiguousarray(np.hstack([(3 * end.nodes[:, :, None] + np.arange(3)).reshape(self.n_bars, -1)
                                                     for end in ends]))
-        self.distributed = any(end.nodes.shape[1] > 1 for end in ends)
+        # distributing ends: the constant (n, 6, m) map from the element dofs to the two end displacements
+        self._spread = _spreading(ends) if any(end.nodes.shape[1] > 1 for end in ends) else None
         # a linear space numbers its scalar dofs like the mesh vertices; mesh.p also holds vertices that no
         # cell uses (nodes of the trusses only), for which the basis has no location
         X = (space.mesh.p if space.order == 1 else space.dof_coordinates).T
@@ -211,9 +212,9 @@ class Truss(Term):
         x_a, x_b = (ref + np.einsum("nk,nkd->nd", end.weights, nodal[end.nodes])
                     for ref, end in zip(self.reference, self.ends, strict=True))
         state = bar_response(x_a, x_b, self.rest_length, self.area, self.laws, tangent, self.slack_stretch, scale)
-        if not self.distributed:
+        if self._spread is None:
             return state
-        spread = _spreading(self.ends)  # (n, 6, m): end positions from the nodes' displacements
+        spread = self._spread
         spread_t = spread.transpose(0, 2, 1)
         state.forces = np.matmul(spread_t, state.forces[:, :, None])[:, :, 0]
         if state.matrices is not None:

@@ -33,12 +33,12 @@ from ..fem.newton import StepEvent, solve
 from ..fem.problem import Problem
 from ..fem.truss import Truss
 from ..io.abaqus import AbaqusModel, read_model, trivalve_input
+from ..io.files import replace_atomically
 from .model import ValveModel, valve_model
 from .surfaces import contact_surface, thinnest_stack
 
 __all__ = ["ClosureOptions", "ClosureSetup", "ClosureRun", "StagedDamping", "closure_setup", "contact_surface",
            "damping_weights", "load_factors", "run_closure"]
-
 
 
 @dataclass
@@ -304,6 +304,4 @@ def write_log(run: ClosureRun, path: Path) -> None:
              f"undamped_residual {run.undamped_residual}", f"error {run.error}"]
     lines += [f"step {k} t={t:.5g} iterations={i} contact_pairs={c}"
               for k, (t, i, c) in enumerate(zip(run.load_factors, run.iterations, run.contact_pairs, strict=True))]
-    temporary = path.with_name(f".{path.name}.tmp")
-    temporary.write_text("\n".join(lines) + "\n")
-    temporary.replace(path)
+    replace_atomically(path, lambda temporary: temporary.write_text("\n".join(lines) + "\n"))
