@@ -20,10 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
+from skvalve.fem.ptc import PseudoTransientOptions
 from skvalve.io.abaqus import read_model, trivalve_input
 from skvalve.io.files import replace_atomically
 from skvalve.papers.mathur2022.figures import write_figures
-from skvalve.valve.closure import ClosureOptions, closure_setup, run_closure, write_log
+from skvalve.valve.closure import ClosureOptions, closure_setup, relax_closure, run_closure, write_log
 from skvalve.valve.model import valve_model
 from skvalve.valve.outputs import ClosureWriter, closure_measures
 
@@ -36,6 +37,10 @@ OPTION_FLAGS = {
     "max_increment": (float, "cap (mm) on a node's displacement change per Newton iteration; 0: none"),
     "regularization": (float, "initial Levenberg-Marquardt shift of the tangent per step (0: plain Newton)"),
     "cable_softening": (float, "initial scale of the chordae's taut law (1: none)"),
+    "contact_from": (float, "step time from which the contact penalty acts"),
+    "contact_exclude_within": (float, "node-face pairs closer than this (mm) in the reference never contact"),
+    "contact_ramp": (float, "step-time interval over which the contact penalty rises smoothly to its value"),
+    "penalty": (float, "contact penalty (MPa/mm)"),
 }
 
 
@@ -47,6 +52,16 @@ class LastState:
 
     def __call__(self, event) -> None:
         replace_atomically(self.path, lambda temporary: np.savez(temporary, t=event.load_factor, u=event.u))
+
+#: flags --ptc-<name> that override a PseudoTransientOptions field
+PTC_FLAGS = {
+    "damping": (float, "damping coefficient c of the pseudo-time flow (N s/mm^4)"),
+    "max_load_step": (float, "largest pseudo-time step while the load moves"),
+    "max_increment": (float, "trust region: largest nodal displacement change per step (mm)"),
+    "first_step": (float, "first pseudo-time step"),
+    "stiffness_damping": (float, "stiffness-proportional damping beta |diag K| / dtau"),
+    "max_strain_increment": (float, "trust region: largest change of an edge's or cable's tensile stretch per step"),
+}
 
 
 def main() -> int:
@@ -60,6 +75,11 @@ def main() -> int:
                             help=f"{text} (default: ClosureOptions.for_model)")
     parser.add_argument("--hold-papillary", action="store_true",
                         help="a variant: papillary tips held where they are (no tethering), pressure stage only")
+    parser.add_argument("--method", choices=("newton", "ptc"), default="ptc",
+                        help="load-stepped Newton with damped steps, or pseudo-transient continuation (default)")
+    for name, (kind, text) in PTC_FLAGS.items():
+        parser.add_argument("--ptc-" + name.replace("_", "-"), type=kind, default=None,
+                            help=f"{text} (default: PseudoTransientOptions)")
     parser.add_argument("--input", type=Path, default=None,
                         help="another TriValve input (.inp; default: the 1.0 diseased valve, $SKVALVE_TRIVALVE)")
     args = parser.parse_args()
@@ -84,6 +104,8 @@ def main() -> int:
     overrides = {name: getattr(args, name) for name in ("end", *OPTION_FLAGS) if getattr(args, name) is not None}
     if overrides.get("max_increment") == 0.0:
         overrides["max_increment"] = None
+    if args.method == "ptc":
+        overrides["damping"] = 0.0  # the pseudo-transient solver damps itself
     options = ClosureOptions.for_model(model, **overrides)
     print(f"input {Path(path).name}: {options}", flush=True)
     setup = closure_setup(options=options, abaqus=abaqus, model=model)
@@ -97,8 +119,15 @@ def main() -> int:
             return pairs
 
         setup.contact.active_pairs = logged_search
-    run = run_closure(setup, options, callbacks=[LastState(args.out)], progress=False, verbose=args.verbose,
-                      u0=u0, t0=t0)
+    if args.method == "ptc":
+        ptc = {name: getattr(args, "ptc_" + name) for name in PTC_FLAGS if getattr(args, "ptc_" + name) is not None}
+        ptc_options = PseudoTransientOptions(rtol=options.rtol, atol=options.atol, **ptc)
+        print(f"pseudo-transient continuation: {ptc_options}", flush=True)
+        run = relax_closure(setup, options.end, ptc_options, callbacks=[LastState(args.out)], progress=False,
+                            verbose=args.verbose, u0=u0, t0=t0)
+    else:
+        run = run_closure(setup, options, callbacks=[LastState(args.out)], progress=False, verbose=args.verbose,
+                          u0=u0, t0=t0)
     write_log(run, args.out / "closure_log.txt")
     print(f"wall time {run.seconds:.1f} s, load steps {len(run.load_factors) - 1}, "
           f"Newton iterations {sum(run.iterations)}, contact pairs at the end "

@@ -13,15 +13,24 @@ from skvalve.fem.constitutive import MaterialRegions
 from skvalve.fem.contact import ContactSurface, SurfaceContact
 from skvalve.fem.damping import DampingSchedule, ViscousDamping
 from skvalve.fem.hyperelastic import HyperelasticTerm
+from skvalve.fem.ptc import PseudoTransientOptions
 from skvalve.io.abaqus import read_model, trivalve_input
 from skvalve.materials import NeoHookean
 from skvalve.papers.mathur2022 import reproduce as reproduce_module
-from skvalve.valve.closure import ClosureOptions, ClosureSetup, contact_surface, load_factors, run_closure
+from skvalve.valve.closure import (
+    ClosureOptions,
+    ClosureSetup,
+    _PenaltyFrom,
+    contact_surface,
+    load_factors,
+    relax_closure,
+    run_closure,
+)
 from skvalve.valve.model import valve_model
 from skvalve.valve.outputs import ClosureWriter
 
 
-def _blocks_setup(shortening: float) -> ClosureSetup:
+def _blocks_setup(shortening: float, damped: bool = True) -> ClosureSetup:
     """Two unit cubes (2x2x2 hexes each) on rollers, the top face pushed down by ``shortening`` x t/end."""
     bottom = skfem.MeshHex.init_tensor(*(np.linspace(0, 1, 3),) * 3)
     top = skfem.MeshHex.init_tensor(*(np.linspace(0, 1, 3),) * 2, np.linspace(1, 2, 3))
@@ -30,7 +39,7 @@ def _blocks_setup(shortening: float) -> ClosureSetup:
     problem = Problem(space, [HyperelasticTerm(space, MaterialRegions(mesh, NeoHookean(1.0, 2.0)))])
     surface = ContactSurface.from_facets(mesh, mesh.facets_satisfying(lambda X: np.abs(X[2] - 1) < 1e-9, True))
     contact = problem.add_term(SurfaceContact(space, surface, 50.0, smoothing=0.01))
-    damping = problem.add_term(ViscousDamping(space, DampingSchedule(0.5, t_off=1.0)))
+    damping = problem.add_term(ViscousDamping(space, DampingSchedule(0.5, t_off=1.0))) if damped else None
     for axis in range(3):
         problem.add_dirichlet(lambda X, a=axis: X[a] == 0.0, 0.0, components=[axis])
     problem.add_dirichlet(lambda X: X[2] == 2.0, lambda X, t: -shortening * t / 1.5 * np.ones_like(X), components=[2])
@@ -52,6 +61,53 @@ def test_closure_driver_reaches_the_end_with_damping_off_and_records_the_run():
     assert run.contact_pairs[-1] == 18  # 9 nodes of each face, two passes
     assert sum(run.iterations) > 0 and run.seconds > 0 and run.peak_memory_mb > 0
     assert run.undamped_residual[1] < 1e-6  # the damping is off at t >= 1: the end state is undamped equilibrium
+
+
+def test_pseudo_transient_closure_ends_where_the_load_stepped_one_does():
+    """Blocks pressed into contact: Ψtc (no equilibrium on the way, the damping its own) must reach the undamped
+    equilibrium that damped Newton load steps reach, with the same contact pairs."""
+    options = ClosureOptions(papillary_steps=2, pressure_steps=2, rtol=1e-9, solver="scipy")
+    newton = run_closure(_blocks_setup(0.15), options, progress=False)
+    relaxed = relax_closure(_blocks_setup(0.15, damped=False), 1.5,
+                            PseudoTransientOptions(damping=0.5, first_step=0.05, max_load_step=0.25, rtol=1e-9,
+                                                   solver="scipy"), progress=False)
+    assert relaxed.error is None and relaxed.load_factors[-1] == 1.5
+    assert relaxed.contact_pairs[-1] == newton.contact_pairs[-1] == 18
+    np.testing.assert_allclose(relaxed.u, newton.u, atol=1e-8)
+    assert relaxed.undamped_residual[1] < 1e-9
+    with pytest.raises(ValueError, match="damping=0"):
+        relax_closure(_blocks_setup(0.15), 1.5, progress=False)
+
+
+def test_contact_pairs_closer_than_exclude_within_in_the_reference_are_never_active():
+    """The two faces at z = 1 coincide in the reference: pressed 0.1 into each other, every node pairs (9 per face,
+    two passes). A node over a triangle lies at most its circumradius (0.37 here) from the centroid in the
+    reference: excluded within 0.4, none pairs (what keeps rim nodes off their own leaflet's inner face); within 0.1
+    (below the smallest vertex-centroid distance, 0.24), all still do."""
+    setup = _blocks_setup(0.15)
+    X = setup.problem.space.dof_coordinates
+    u = np.zeros(setup.problem.space.n_dofs)
+    u[2::3][X[2] > 1.0 + 1e-9] -= 0.1
+    top_face = np.flatnonzero(np.isclose(X[2], 1.0))
+    top_face = top_face[top_face >= 27]  # the top block's copy of the face
+    u[3 * top_face + 2] -= 0.1
+    contact = setup.contact
+    assert contact.active_pairs(u).size == 18
+    contact.exclude_within = 0.1
+    assert contact.active_pairs(u).size == 18
+    contact.exclude_within = 0.4
+    assert contact.active_pairs(u).size == 0
+    with pytest.raises(ValueError, match="exclude_within"):
+        SurfaceContact(setup.problem.space, contact.surface, 1.0, exclude_within=-1.0)
+
+
+def test_contact_penalty_switches_on_by_a_smooth_step():
+    ramp = _PenaltyFrom(2.0, 0.5, 0.1)
+    assert ramp(0.49) == 0.0 and ramp(0.5) == 0.0 and ramp(0.6) == ramp(1.0) == 2.0
+    assert ramp(0.55) == pytest.approx(1.0, rel=1e-14)  # S(1/2) = 1/2
+    values = [ramp(t) for t in np.linspace(0.5, 0.6, 21)]
+    assert np.all(np.diff(values) > 0)
+    assert _PenaltyFrom(2.0, 0.5)(0.5) == 2.0  # no ramp: a switch
 
 
 def test_a_failed_closure_reports_where_it_stopped_and_keeps_the_last_state():

@@ -218,6 +218,8 @@ class SurfaceContact(Term):
     opposing : :math:`c` in :math:`n_s\\cdot n < -c` (normals must oppose).
     tolerance : barycentric band :math:`\\epsilon` past a triangle's edges (neighbours and free edges).
     smoothing : :math:`h_0`, the overlap over which the penalty is rounded (default 1 % of the mean edge).
+    exclude_within : a node never contacts a triangle whose reference centroid lies closer than this (self-contact of
+        a thick surface: across a free edge's rim the two skins are a thickness apart and, bent, seem to overlap).
     """
 
     name = "contact"
@@ -225,7 +227,7 @@ class SurfaceContact(Term):
 
     def __init__(self, space: Space, surface: ContactSurface, penalty, max_penetration: float | None = None,
                  exclude_rings: int = 2, opposing: float = 0.2, tolerance: float = 0.05,
-                 smoothing: float | None = None) -> None:
+                 smoothing: float | None = None, exclude_within: float = 0.0) -> None:
         if space.dim != 3 or space.order != 1:
             raise ValueError("contact: needs a linear 3D displacement space")
         if surface.nodes.max() >= space.n_scalar:
@@ -245,6 +247,10 @@ class SurfaceContact(Term):
         self.area = np.zeros(space.n_scalar)
         self.area[surface.nodes] = surface.nodal_area
         self._excluded = _neighbourhood_keys(surface, exclude_rings)
+        if not (np.isfinite(exclude_within) and exclude_within >= 0.0):
+            raise ValueError(f"contact: exclude_within must be finite and >= 0; got {exclude_within!r}")
+        self.exclude_within = float(exclude_within)
+        self._reference_centroids = self.X[surface.triangles].mean(axis=1)
         self.last_pairs: ActivePairs | None = None
         self._previous = np.full(space.n_scalar, -1, dtype=np.int64)  # triangle of each node at the last search
         self.last_force = np.zeros(space.n_u)
@@ -268,6 +274,8 @@ class SurfaceContact(Term):
         node = np.repeat(slaves, counts)
         triangle = np.fromiter((j for item in lists for j in item), dtype=np.int64, count=int(counts.sum()))
         keep = ~np.isin(node * tri.shape[0] + triangle, self._excluded, assume_unique=False)
+        if self.exclude_within > 0.0:
+            keep &= np.linalg.norm(self.X[node] - self._reference_centroids[triangle], axis=1) >= self.exclude_within
         node, triangle = node[keep], triangle[keep]
         c = corners[triangle]
         m = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])

@@ -26,11 +26,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fem.amplitudes import GeometricRamp
+from ..fem.amplitudes import GeometricRamp, smooth_step_polynomial
 from ..fem.contact import SurfaceContact
 from ..fem.damping import ViscousDamping, lumped_volume, undamped_residual
 from ..fem.newton import StepEvent, solve
 from ..fem.problem import Problem
+from ..fem.ptc import PseudoTransientOptions, pseudo_transient
 from ..fem.truss import Truss
 from ..io.abaqus import AbaqusModel, read_model, trivalve_input
 from ..io.files import replace_atomically
@@ -38,7 +39,7 @@ from .model import ValveModel, valve_model
 from .surfaces import contact_surface, thinnest_stack
 
 __all__ = ["ClosureOptions", "ClosureSetup", "ClosureRun", "StagedDamping", "closure_setup", "contact_surface",
-           "damping_weights", "load_factors", "run_closure"]
+           "damping_weights", "load_factors", "relax_closure", "run_closure", "watched_edges"]
 
 
 @dataclass
@@ -63,6 +64,13 @@ class ClosureOptions:
     pressure_damping : :math:`c_0` from ``pressure_start`` on, decaying to zero at ``damping_off``
     (:class:`StagedDamping`): the leaflets under the first, tiny pressures are nearly free, and nothing prescribed
     drags them there, so they take far more damping than the papillary stage does.
+    contact_exclude_within : node-face pairs whose reference distance is below this never contact
+    (:class:`~skvalve.fem.contact.SurfaceContact` ``exclude_within``; on the 1.0 valve the only pairs of the papillary
+    stage were rim nodes against the inner face of their own leaflet 0.5 mm away, across the 0.78 mm thick corner).
+    contact_ramp : the penalty rises from zero at ``contact_from`` to ``penalty`` over this step-time interval (a smooth
+    step): folds that overlap when it switches on are pushed apart gradually (switched on at once, three overlapping
+    pairs at the free edge of the 1.0 valve threw their nodes by millimetres and stalled the pseudo-time steps at
+    ~1e-6).
     contact_from : step time from which the contact penalty acts (the pressure's start by :meth:`for_model`): in the
     papillary stage the chords pull the leaflets apart, and the few pairs that folds of one leaflet make there
     (1–7 on the 1.0 valve) switched on and off between iterates and stalled Newton.
@@ -99,6 +107,8 @@ class ClosureOptions:
     max_increment: float | None = None
     regularization: float = 0.0
     contact_from: float = 0.5
+    contact_ramp: float = 0.0
+    contact_exclude_within: float = 0.0
     pressure_damping: float = 1e-4
 
     @classmethod
@@ -179,8 +189,10 @@ def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: Abaq
     # quarter of the thinnest stack keeps them from pairing (bricks: the contact term's default depth)
     thinnest = thinnest_stack(model, abaqus)
     depth = None if thinnest is None else 0.25 * thinnest
-    penalty = options.penalty if options.contact_from <= 0.0 else _PenaltyFrom(options.penalty, options.contact_from)
-    contact = problem.add_term(SurfaceContact(problem.space, surface, penalty, max_penetration=depth))
+    penalty = options.penalty if options.contact_from <= 0.0 and options.contact_ramp <= 0.0 else \
+        _PenaltyFrom(options.penalty, options.contact_from, options.contact_ramp)
+    contact = problem.add_term(SurfaceContact(problem.space, surface, penalty, max_penetration=depth,
+                                              exclude_within=options.contact_exclude_within))
     damping = None
     if options.damping > 0.0:
         schedule = StagedDamping(options.damping, options.pressure_damping, options.pressure_start,
@@ -243,6 +255,61 @@ def run_closure(setup: ClosureSetup, options: ClosureOptions | None = None, call
     return run
 
 
+def relax_closure(setup: ClosureSetup, end: float, options: PseudoTransientOptions | None = None, callbacks=(),
+                  progress: bool = True, verbose: bool = False, u0: np.ndarray | None = None,
+                  t0: float = 0.0) -> ClosureRun:
+    """The closure by pseudo-transient continuation (:func:`~skvalve.fem.ptc.pseudo_transient`): one damped,
+    linearised step per pseudo-time step, no equilibrium asked for on the way, relaxed at ``end`` to the undamped
+    equilibrium. ``setup`` must have no damping term (``ClosureOptions(damping=0)``): the damping is the
+    solver's, with :func:`damping_weights`. Never raises for a failed run: the error and the last state are recorded.
+    """
+    if setup.damping is not None:
+        raise ValueError("relax_closure damps through the solver: build the setup with ClosureOptions(damping=0)")
+    options = options or PseudoTransientOptions()
+    run = ClosureRun()
+
+    def record(event) -> None:
+        run.load_factors.append(float(event.load_factor))
+        run.iterations.append(1)
+        run.contact_pairs.append(setup.contact.last_pairs.size if setup.contact.last_pairs is not None else 0)
+        run.u = event.u
+
+    edges, rest_lengths = watched_edges(setup.model) if setup.model is not None else (None, None)
+    start = time.perf_counter()
+    result = None
+    try:
+        result = pseudo_transient(setup.problem, damping_weights(setup.problem.space), end, options, u0=u0, t0=t0,
+                                  edges=edges, rest_lengths=rest_lengths, callbacks=[record, *callbacks],
+                                  progress=progress, verbose=verbose)
+    except Exception as err:  # noqa: BLE001 - a failed closure is a result to report, with its last state
+        run.error = f"{type(err).__name__}: {err}"
+        result = getattr(err, "last_state", None)
+    finally:
+        run.peak_memory_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: kB
+        run.seconds = time.perf_counter() - start
+    if result is not None:
+        run.timings = dict(result.timings)
+        run.timings["rejected_steps"] = float(result.rejected)
+        if result.converged is False and run.error is None:
+            run.error = "did not converge"
+    if run.u is not None:
+        run.undamped_residual = undamped_residual(setup.problem, run.u, run.load_factors[-1])
+    return run
+
+
+def watched_edges(model: ValveModel) -> tuple[np.ndarray, np.ndarray]:
+    """Node pairs whose tensile stretch the pseudo-transient trust region limits, and the lengths from which they
+    carry tension: every pair of a hex's vertices (edges and diagonals, whatever the vertex order; their reference
+    lengths) and the cables (their rest lengths)."""
+    hexes = model.mesh.t.T
+    pairs = [(a, b) for a in range(hexes.shape[1]) for b in range(a + 1, hexes.shape[1])]
+    in_hexes = np.concatenate([hexes[:, [a, b]] for a, b in pairs])
+    X = model.mesh.p.T
+    lengths = np.linalg.norm(X[in_hexes[:, 1]] - X[in_hexes[:, 0]], axis=1)
+    return (np.concatenate([in_hexes, model.chordae.ends]),
+            np.concatenate([lengths, np.asarray(model.chordae.rest_length, dtype=float)]))
+
+
 def damping_weights(space) -> np.ndarray:
     """Lumped nodal volumes, with the nodes of no leaflet cell (chordae branch points) given the median nodal
     volume: a branch point whose cables are all slack has only their slack springs, and without damping Newton
@@ -275,13 +342,18 @@ class StagedDamping:
 
 @dataclass(frozen=True)
 class _PenaltyFrom:
-    """Contact penalty ``value`` from step time ``start`` on, zero before."""
+    """Contact penalty: zero before ``start``, ``value`` from ``start + ramp`` on, a smooth step in between."""
 
     value: float
     start: float
+    ramp: float = 0.0
 
     def __call__(self, t: float) -> float:
-        return self.value if t >= self.start else 0.0
+        if t < self.start:
+            return 0.0
+        if self.ramp <= 0.0 or t >= self.start + self.ramp:
+            return self.value
+        return self.value * float(smooth_step_polynomial((t - self.start) / self.ramp))
 
 
 class _AfterStart:

@@ -1,0 +1,356 @@
+r"""Pseudo-transient continuation (Ψtc): a linearly implicit, damped path to an equilibrium.
+
+Newton with load steps asks for an equilibrium at every step; a structure with mechanisms along the path
+(leaflets that swing freely until their chords or neighbours stop them, cables between slack and taut) has
+steps where the damped equilibrium is far from the start and Newton needs tens of iterations or fails. Ψtc
+(Kelley & Keyes 1998, *SIAM J. Numer. Anal.* 35:508; Coffey, Kelley & Keyes 2003) asks for no equilibrium on
+the way: each pseudo-time step :math:`\Delta\tau_k` takes *one* linearised implicit-Euler step of the
+gradient-like flow :math:`c\,M\,\dot u = -R(u, t)`,
+
+.. math::
+
+    \Big(K_{ff}(u_k, t_{k+1}) + \frac{c}{\Delta\tau_k}\,M_{ff}\Big)\,\Delta u_f
+        = -R_f(u_k, t_{k+1}) - K_{fD}\,\Delta u_D ,
+
+with :math:`M` a diagonal of lumped nodal volumes (optionally plus :math:`\beta\,|\mathrm{diag}\,K_{ff}|/c`, a
+stiffness-proportional part), the load factor following pseudo-time up to ``end``
+(:math:`t_{k+1} = \min(\tau_k + \Delta\tau_k, t_\text{end})`, prescribed values and loads included) and held after. The step length follows switched evolution relaxation (SER),
+:math:`\Delta\tau_{k+1} = \Delta\tau_k \min(g, \lVert R_k\rVert / \lVert R_{k+1}\rVert)`: while the residual
+falls the damping :math:`c/\Delta\tau` fades and the iteration becomes Newton's, converging quadratically to
+the undamped equilibrium. :math:`R` is always the undamped residual (the damping lives in the matrix only),
+so the convergence test is on the problem itself.
+
+A step is rejected (terms rewound, :math:`\Delta\tau` cut) when an element inverts, when some node would move
+more than ``max_increment`` (a trust region), or when :math:`\lVert R\rVert` grows by more than ``blow_up``;
+a step below ``min_step`` raises :class:`~skvalve.fem.errors.ConvergenceError` (or the inversion's
+:class:`~skvalve.fem.errors.NonPositiveJacobianError`) with pseudo-step and load factor, the last accepted
+state in ``error.last_state``.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+from tqdm.auto import tqdm
+
+from . import linsolve
+from .errors import ConvergenceError, NonPositiveJacobianError
+from .problem import Problem
+
+__all__ = ["PseudoTransientOptions", "PseudoTransientStep", "PseudoTransientResult", "pseudo_transient"]
+
+logger = logging.getLogger("skvalve.fem")
+
+
+@dataclass
+class PseudoTransientOptions:
+    r"""Controls of :func:`pseudo_transient` (units of the problem).
+
+    damping : :math:`c`, the coefficient of :math:`M/\Delta\tau` (force per volume per length per unit pseudo-time).
+    stiffness_damping : :math:`\beta`, a damping proportional to the tangent's diagonal,
+        :math:`\beta\,|\mathrm{diag}\,K_{ff}|/\Delta\tau` (Rayleigh's stiffness-proportional part, dimensionless
+        times pseudo-time): it damps most where the material is stiffest, which is where an element driven far
+        into an exponential law loses stability (modes with negative curvature that a volume-proportional damping
+        of the soft leaflet cannot hold without tiny steps everywhere). Zero: off.
+    first_step, min_step : the first :math:`\Delta\tau`, and the smallest before giving up.
+    max_load_step : the largest :math:`\Delta\tau` while the load factor still moves (the load path's resolution).
+    growth : the largest SER growth of :math:`\Delta\tau` per step once the load is held.
+    load_growth : the growth of :math:`\Delta\tau` per accepted step while the load moves (back towards
+        ``max_load_step`` after a cut; a gentle value wastes fewer rejected steps on a path whose trust regions bind).
+    max_increment : trust region: the largest nodal displacement change in one step (length), ``None``: off.
+    max_strain_increment : trust region on the ``edges`` given to :func:`pseudo_transient`: the largest change of an
+        edge's tensile stretch :math:`\max(\ell/L, 1)` in one step (``None``: off; slack cables and shortening edges
+        move freely). Exponential laws (collagenous leaflets, chordae) need it: a linearised step taken from the
+        flat toe of such a law into its steep part overshoots by orders of magnitude, however small the nodal
+        displacement.
+    blow_up : reject a step whose residual exceeds this multiple of the reference (the larger of the residual before
+        the step and the linearised one with the new prescribed values).
+    rtol, atol : converged, once the load is at ``end``, when :math:`\lVert R_f\rVert \le \max(\text{rtol}
+        \max(\lVert R_D\rVert, \lVert f_\text{ext}\rVert), \text{atol})`.
+    max_steps : the most accepted pseudo-steps.
+    """
+
+    damping: float = 1e-4
+    stiffness_damping: float = 0.0
+    first_step: float = 1e-3
+    min_step: float = 1e-9
+    max_load_step: float = 0.01
+    growth: float = 2.0
+    load_growth: float = 1.25
+    max_increment: float | None = 0.5
+    max_strain_increment: float | None = 0.05
+    blow_up: float = 10.0
+    rtol: float = 1e-6
+    atol: float = 0.0
+    max_steps: int = 5000
+    solver: str | None = None
+
+    def __post_init__(self) -> None:
+        positive = ("damping", "first_step", "min_step", "max_load_step", "growth", "load_growth", "blow_up", "rtol")
+        for name in positive:
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
+                raise ValueError(f"PseudoTransientOptions.{name} must be a positive finite number; got {value!r}")
+        if self.max_increment is not None and not (math.isfinite(self.max_increment) and self.max_increment > 0):
+            raise ValueError("PseudoTransientOptions.max_increment must be None or positive; "
+                             f"got {self.max_increment!r}")
+        if self.max_strain_increment is not None and not (math.isfinite(self.max_strain_increment)
+                                                          and self.max_strain_increment > 0):
+            raise ValueError("PseudoTransientOptions.max_strain_increment must be None or positive; "
+                             f"got {self.max_strain_increment!r}")
+        if not (math.isfinite(self.stiffness_damping) and self.stiffness_damping >= 0):
+            raise ValueError("PseudoTransientOptions.stiffness_damping must be finite and >= 0; "
+                             f"got {self.stiffness_damping!r}")
+        if not (math.isfinite(self.atol) and self.atol >= 0):
+            raise ValueError(f"PseudoTransientOptions.atol must be finite and >= 0; got {self.atol!r}")
+        if self.growth < 1.0 or self.load_growth < 1.0:
+            raise ValueError(f"PseudoTransientOptions.growth and load_growth must be >= 1; got {self.growth!r}, "
+                             f"{self.load_growth!r}")
+
+
+@dataclass
+class PseudoTransientStep:
+    """What a callback receives after each accepted pseudo-step."""
+
+    problem: Problem
+    step: int
+    pseudo_time: float
+    load_factor: float
+    u: np.ndarray
+    residual_norm: float
+    relative_residual: float
+
+
+@dataclass
+class PseudoTransientResult:
+    """Accepted steps (pseudo-time, load factor, step length, residual, largest nodal change), the last state."""
+
+    u: np.ndarray
+    load_factor: float
+    pseudo_times: list[float] = field(default_factory=list)
+    load_factors: list[float] = field(default_factory=list)
+    step_lengths: list[float] = field(default_factory=list)
+    residuals: list[float] = field(default_factory=list)
+    largest_increments: list[float] = field(default_factory=list)
+    rejected: int = 0
+    converged: bool = False
+    relative_residual: float = math.inf
+    timings: dict[str, float] = field(default_factory=lambda: {"assembly": 0.0, "solve": 0.0})
+
+
+class _Rejected(Exception):
+    pass
+
+
+def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options: PseudoTransientOptions | None = None,
+                     *, u0: np.ndarray | None = None, t0: float = 0.0, edges: np.ndarray | None = None,
+                     rest_lengths: np.ndarray | None = None,
+                     callbacks: Sequence[Callable[[PseudoTransientStep], None]] = (), progress: bool = True,
+                     verbose: bool = False) -> PseudoTransientResult:
+    """Follow the load factor from ``t0`` to ``end`` and relax to the equilibrium at ``end`` (module docstring).
+
+    ``weights``: the diagonal :math:`M` (n_dofs,), e.g. :func:`~skvalve.fem.damping.lumped_volume`; dofs with zero
+    weight get no damping. ``edges``: (m, 2) node pairs (element edges, cables) watched by ``max_strain_increment``,
+    ``rest_lengths`` the lengths from which each carries tension (default: the reference lengths; for a cable, its
+    rest length).
+    Returns a :class:`PseudoTransientResult` with ``converged`` set; raises
+    :class:`~skvalve.fem.errors.ConvergenceError` / :class:`~skvalve.fem.errors.NonPositiveJacobianError` when the
+    step falls below ``min_step`` or ``max_steps`` pass (``error.last_state``: the last accepted result).
+    """
+    opts = options or PseudoTransientOptions()
+    solver = linsolve.solver_name(opts.solver)
+    n = problem.space.n_dofs
+    weights = np.asarray(weights, dtype=float).ravel()
+    if weights.shape != (n,) or not np.all(np.isfinite(weights) & (weights >= 0.0)):
+        raise ValueError(f"weights must be {n} finite values >= 0")
+    if not (math.isfinite(end) and end >= t0 >= 0.0):
+        raise ValueError(f"need 0 <= t0 <= end; got t0={t0!r}, end={end!r}")
+    if edges is not None:
+        edges = _checked_edges(problem, edges, rest_lengths)
+    problem.check_supports()
+    pattern = problem.pattern
+    fixed, free = pattern.fixed, pattern.free
+    u = np.zeros(n) if u0 is None else np.array(u0, dtype=float)
+    _, values = problem.constrained(t0)
+    u[fixed] = values
+    result = PseudoTransientResult(u=u, load_factor=t0)
+    start = time.perf_counter()
+    residual, tangent = problem.assemble(u, t0, tangent=True, step=0)
+    result.timings["assembly"] += time.perf_counter() - start
+    norm = float(np.linalg.norm(residual[free]))
+    tau, t, dtau = t0, t0, opts.first_step
+    failure: Exception | None = None
+    bar = tqdm(total=None if end == t0 else 100, disable=not progress, desc="pseudo-time", leave=False)
+    try:
+        while len(result.pseudo_times) < opts.max_steps:
+            relative = norm / _reference(problem, residual, fixed)
+            if t >= end and (relative <= opts.rtol or norm <= opts.atol):
+                result.converged, result.relative_residual = True, relative
+                break
+            if dtau < opts.min_step:
+                error_type = NonPositiveJacobianError if isinstance(failure, NonPositiveJacobianError) else None
+                raise _give_up(error_type, failure, len(result.pseudo_times) + 1, t, result, dtau)
+            if t < end:
+                dtau = min(dtau, opts.max_load_step)
+            t_new = min(tau + dtau, end) if t < end else end
+            if t < end and end - t_new < 1e-12 * max(1.0, end):
+                t_new = end
+            step = len(result.pseudo_times) + 1
+            try:
+                trial, trial_residual, trial_tangent, largest = _step(problem, u, t, t_new, dtau, tangent, weights,
+                                                                       norm, opts, solver, step, result.timings,
+                                                                       edges)
+            except _Rejected as err:
+                problem.rewind()
+                result.rejected += 1
+                failure = err.__cause__ if err.__cause__ is not None else err
+                factor = getattr(err, "factor", 0.25)
+                logger.info("pseudo-step %d (t=%.5g, dtau=%.3g) rejected: %s", step, t_new, dtau, err)
+                if verbose:
+                    print(f"  rejected pseudo-step {step} t={t_new:.5g} dtau={dtau:.3g}: {err}", flush=True)
+                dtau *= factor
+                continue
+            problem.commit()
+            previous = norm
+            u, residual, tangent = trial, trial_residual, trial_tangent
+            norm = float(np.linalg.norm(residual[free]))
+            tau, t = tau + dtau, t_new
+            relative = norm / _reference(problem, residual, fixed)
+            result.u, result.load_factor, result.relative_residual = u, t, relative
+            for name, value in (("pseudo_times", tau), ("load_factors", t), ("step_lengths", dtau),
+                                ("residuals", norm), ("largest_increments", largest)):
+                getattr(result, name).append(value)
+            if verbose:
+                print(f"pseudo-step {step} tau={tau:.5g} t={t:.5g} dtau={dtau:.3g} |R|={norm:.3e} rel={relative:.3e} "
+                      f"max|du|={largest:.3g}", flush=True)
+            if not bar.disable:
+                bar.n = int(100 * min(t - t0, end - t0) / (end - t0)) if end > t0 else 100
+                bar.set_postfix(rel=f"{relative:.1e}", dtau=f"{dtau:.1e}")
+                bar.refresh()
+            event = PseudoTransientStep(problem, step, tau, t, u, norm, relative)
+            for callback in callbacks:
+                callback(event)
+            if t < end:  # following the load: grow back towards the load path's resolution after cuts
+                dtau = min(dtau * opts.load_growth, opts.max_load_step)
+            else:  # switched evolution relaxation
+                dtau *= min(opts.growth, max(previous / max(norm, 1e-300), 0.5))
+            failure = None
+        else:
+            raise _give_up(None, None, len(result.pseudo_times), t, result, dtau,
+                           reason=f"{opts.max_steps} pseudo-steps without converging")
+    finally:
+        bar.close()
+    return result
+
+
+def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent, weights, norm: float,
+          opts: PseudoTransientOptions, solver: str, step: int, timings: dict, edges: tuple | None):
+    """One linearised implicit-Euler step; raises :class:`_Rejected` (with a cut ``factor``) when it fails a test."""
+    pattern = problem.pattern
+    fixed, free = pattern.fixed, pattern.free
+    clock = time.perf_counter()
+    residual, tangent = problem.assemble(u, t_new, tangent=True, step=step, reuse=tangent)
+    rhs = residual.copy()
+    trial = u.copy()
+    if fixed.size and t_new != t_old:
+        _, old_values = problem.constrained(t_old)
+        _, new_values = problem.constrained(t_new)
+        prescribed = np.zeros_like(u)
+        prescribed[fixed] = new_values - old_values
+        rhs += problem.apply(tangent, prescribed)
+        trial[fixed] = new_values
+    K = problem.tangent_matrix(tangent)
+    diagonal = opts.damping * weights[free]
+    if opts.stiffness_damping > 0.0:
+        diagonal = diagonal + opts.stiffness_damping * np.abs(K.diagonal())
+    K = K + sp.diags(diagonal / dtau, format="csr")
+    timings["assembly"] += time.perf_counter() - clock
+    clock = time.perf_counter()
+    try:
+        du_free = linsolve.solve(K, -rhs[free], solver, symmetric=problem.symmetric)
+    except np.linalg.LinAlgError as err:
+        raise _Rejected(f"singular damped tangent: {err}") from err
+    finally:
+        timings["solve"] += time.perf_counter() - clock
+    if not np.all(np.isfinite(du_free)):
+        raise _Rejected("the linear solve returned non-finite values")
+    du = np.zeros_like(u)
+    du[free] = du_free
+    space = problem.space
+    largest = float(np.max(np.linalg.norm(du[: space.n_u].reshape(-1, space.dim), axis=1), initial=0.0))
+    if opts.max_increment is not None and largest > opts.max_increment:
+        rejected = _Rejected(f"a node would move {largest:.3g} > max_increment {opts.max_increment:g}")
+        rejected.factor = max(0.1, 0.7 * opts.max_increment / largest)
+        raise rejected
+    trial[free] += du_free
+    if edges is not None and opts.max_strain_increment is not None and edges[0].size:
+        change, worst = _largest_stretch_change(edges[2], u, trial, edges[0], edges[1])
+        if change > opts.max_strain_increment:
+            a, b = edges[0][worst]
+            rejected = _Rejected(f"the stretch of edge {a}-{b} would change by {change:.3g} > max_strain_increment "
+                                 f"{opts.max_strain_increment:g}")
+            rejected.factor = max(0.1, 0.7 * opts.max_strain_increment / change)
+            raise rejected
+    clock = time.perf_counter()
+    try:
+        trial_residual, trial_tangent = problem.assemble(trial, t_new, tangent=True, step=step)
+    except NonPositiveJacobianError as err:
+        raise _Rejected(f"inverted elements: {err}") from err
+    finally:
+        timings["assembly"] += time.perf_counter() - clock
+    trial_norm = float(np.linalg.norm(trial_residual[free]))
+    reference = max(norm, float(np.linalg.norm(rhs[free])))
+    if not (trial_norm <= opts.blow_up * reference):
+        raise _Rejected(f"|R| grows from {reference:.3e} to {trial_norm:.3e}")
+    return trial, trial_residual, trial_tangent, largest
+
+
+def _largest_stretch_change(X: np.ndarray, u: np.ndarray, trial: np.ndarray, edges: np.ndarray,
+                            rest: np.ndarray) -> tuple[float, int]:
+    r"""The largest change of an edge's tensile stretch :math:`\max(\ell/L, 1)` between ``u`` and ``trial``, and
+    that edge (``rest``: the lengths :math:`L` at which each edge starts to carry tension)."""
+    n = X.shape[0] * X.shape[1]
+    before = X + u[:n].reshape(X.shape)
+    after = X + trial[:n].reshape(X.shape)
+    old = np.maximum(np.linalg.norm(before[edges[:, 1]] - before[edges[:, 0]], axis=1) / rest, 1.0)
+    new = np.maximum(np.linalg.norm(after[edges[:, 1]] - after[edges[:, 0]], axis=1) / rest, 1.0)
+    change = np.abs(new - old)
+    worst = int(np.argmax(change)) if change.size else -1
+    return (float(change[worst]) if change.size else 0.0), worst
+
+
+def _checked_edges(problem: Problem, edges, rest_lengths) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(pairs, rest lengths, reference nodal coordinates (n, dim)); rest lengths default to the reference ones."""
+    space = problem.space
+    nodes = space.n_u // space.dim
+    pairs = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    if pairs.size and (pairs.min() < 0 or pairs.max() >= nodes):
+        raise ValueError(f"edges must be node pairs in 0..{nodes - 1}")
+    X = np.ascontiguousarray(space.dof_coordinates[:, :nodes].T)
+    rest = np.linalg.norm(X[pairs[:, 1]] - X[pairs[:, 0]], axis=1) if rest_lengths is None else \
+        np.asarray(rest_lengths, dtype=float).ravel()
+    if rest.shape != (pairs.shape[0],) or not np.all(np.isfinite(rest) & (rest > 0.0)):
+        raise ValueError(f"edge rest lengths must be {pairs.shape[0]} positive finite lengths")
+    return pairs, rest, X
+
+
+def _reference(problem: Problem, residual: np.ndarray, fixed: np.ndarray) -> float:
+    return max(float(np.linalg.norm(residual[fixed])), float(np.linalg.norm(problem.external_forces)), 1e-300)
+
+
+def _give_up(error_type, cause, step: int, t: float, result: PseudoTransientResult, dtau: float,
+             reason: str | None = None):
+    if error_type is NonPositiveJacobianError and cause is not None:
+        error = NonPositiveJacobianError(cause.elements, step, t)
+    else:
+        reason = reason or f"the pseudo-time step fell to {dtau:.2e} (last rejection: {cause})"
+        error = ConvergenceError(f"pseudo-transient continuation stopped at pseudo-step {step}, load factor {t:.6g}: "
+                                 f"{reason}; last accepted load factor {result.load_factor:.6g}")
+    error.last_state = result
+    return error

@@ -1,0 +1,117 @@
+"""Pseudo-transient continuation (:mod:`skvalve.fem.ptc`): it converges to the undamped equilibrium that load-stepped
+Newton or a closed form gives, its trust regions hold on every accepted step, and bad input fails clearly."""
+
+import numpy as np
+import pytest
+import skfem
+from scipy.optimize import brentq
+
+from skvalve.fem import NodalForce, Problem, Solid, Space, solve
+from skvalve.fem.damping import lumped_volume
+from skvalve.fem.errors import ConvergenceError
+from skvalve.fem.ptc import PseudoTransientOptions, pseudo_transient
+from skvalve.fem.truss import Truss
+from skvalve.materials import NeoHookean
+from skvalve.materials.uniaxial import OgdenUniaxial, TensionOnly
+
+
+def _sheared_block() -> Solid:
+    """A unit block (4x4x4 hexes) clamped at x = 0 whose face x = 1 is moved 0.5 along z: bending and shear."""
+    solid = Solid(skfem.MeshHex().refined(2), NeoHookean(1.0, 10.0))
+    solid.add_dirichlet(lambda X: X[0] == 0.0, 0.0)
+    solid.add_dirichlet(lambda X: X[0] == 1.0, np.array([0.0, 0.0, 0.5]))
+    return solid
+
+
+def test_relaxes_to_the_equilibrium_newton_reaches():
+    """An elastic problem is path independent: Ψtc (one damped linear step per pseudo-step, no equilibrium on the
+    way) must end where 10 converged Newton load steps end, and its last steps must converge like Newton's."""
+    newton = solve(_sheared_block(), 10, progress=False, rtol=1e-11)
+    block = _sheared_block()
+    seen = []
+    result = pseudo_transient(block, lumped_volume(block.space), 1.0,
+                              PseudoTransientOptions(damping=1.0, first_step=0.05, max_load_step=0.1, rtol=1e-11,
+                                                     max_increment=None, max_strain_increment=None),
+                              progress=False, callbacks=[seen.append])
+    assert result.converged and result.load_factor == 1.0
+    assert np.abs(result.u - newton.u()).max() <= 1e-9 * np.abs(newton.u()).max()
+    # the residual it reports is the undamped one, recomputed independently
+    residual, _ = block.assemble(result.u, 1.0, tangent=False)
+    free, fixed = block.pattern.free, block.pattern.fixed
+    assert np.linalg.norm(residual[free]) == pytest.approx(result.residuals[-1], rel=1e-10)
+    assert np.linalg.norm(residual[free]) <= 1e-11 * np.linalg.norm(residual[fixed])
+    # the load follows pseudo-time, then is held while the damping fades (SER: growing steps, falling residual)
+    assert result.load_factors == sorted(result.load_factors)
+    held = np.flatnonzero(np.array(result.load_factors) == 1.0)
+    assert result.step_lengths[held[-1]] > 10 * result.step_lengths[held[0]]
+    assert result.residuals[-1] < 1e-6 * max(result.residuals)
+    assert [event.step for event in seen] == list(range(1, len(result.pseudo_times) + 1))
+
+
+def _two_nodes(L: float = 2.0):
+    space = Space(skfem.MeshHex().scaled([L, L, L]))
+    X = space.dof_coordinates
+    a = int(np.flatnonzero(np.all(np.isclose(X, 0.0), axis=0))[0])
+    b = int(np.flatnonzero(np.isclose(X[0], L) & np.isclose(X[1], 0) & np.isclose(X[2], 0))[0])
+    return space, a, b
+
+
+def _slack_chord(force: float):
+    """An Ogden chord (alpha = 50, as the tricuspid chordae) from a fixed node to a node 2 away that a force pulls
+    along the chord; rest length 2.2: slack at the start, held only by its slack spring (1e-6 of the modulus)."""
+    space, a, b = _two_nodes()
+    law = OgdenUniaxial((4.0, 15.0), (50.0, 50.0))
+    chord = Truss(space, [[a, b]], 0.33, TensionOnly(law, slack_fraction=1e-6), rest_length=[2.2],
+                  slack_stretch=[2.0 / 2.2])
+    problem = Problem(space, [chord])
+    problem.add_dirichlet(nodes=np.setdiff1d(np.arange(space.n_scalar), [b]), value=0.0)
+    problem.add_dirichlet(nodes=[b], value=0.0, components=[1, 2])
+    problem.add_term(NodalForce(space, np.array([b]), [force, 0.0, 0.0], ramp=True))
+    return problem, law, b
+
+
+def test_slack_exponential_chord_against_the_closed_form_with_the_strain_trust_region():
+    """From slack, the tangent is the slack spring's: a linearised step would throw the end metres away, into
+    lambda^50. The strain trust region (5 % per step) walks it taut; the end state solves A P(lambda) = F."""
+    force = 2.0
+    problem, law, b = _slack_chord(force)
+    weights = np.zeros(problem.space.n_dofs)
+    weights[3 * b] = 1.0
+    options = PseudoTransientOptions(damping=1e-3, first_step=0.1, max_load_step=0.1, rtol=1e-12, atol=1e-13,
+                                     max_strain_increment=0.05, max_increment=None)
+    lengths = [2.0]
+    result = pseudo_transient(problem, weights, 1.0, options, edges=np.array([[0, b]]), rest_lengths=[2.2],
+                              progress=False,
+                              callbacks=[lambda event: lengths.append(2.0 + event.u[3 * b])])
+    assert result.converged
+    k_slack = 1e-6 * law.young_modulus  # the parallel slack spring, from the slack stretch 2/2.2 on
+
+    def balance(lam):
+        return 0.33 * (law.nominal_stress(np.array([lam]))[0][0] + k_slack * (lam - 2.0 / 2.2)) - force
+
+    stretch = brentq(balance, 1.0, 1.5, xtol=1e-15)
+    assert (2.0 + result.u[3 * b]) / 2.2 == pytest.approx(stretch, rel=1e-10)
+    taut_stretch = np.maximum(np.array(lengths) / 2.2, 1.0)
+    assert np.abs(np.diff(taut_stretch)).max() <= 0.05 * (1 + 1e-12)  # the trust region held on every accepted step
+    assert result.rejected > 0  # and had work to do
+    # without it, the first linearised step leaves the chord far beyond the root (what Newton's first iterate does)
+    assert 0.1 * force / (0.33 * k_slack / 2.2) > 1e3
+
+
+def test_bad_input_and_giving_up():
+    problem, _, b = _slack_chord(2.0)
+    with pytest.raises(ValueError, match="weights must be"):
+        pseudo_transient(problem, np.ones(3), 1.0, progress=False)
+    with pytest.raises(ValueError, match="edges must be node pairs"):
+        pseudo_transient(problem, np.ones(problem.space.n_dofs), 1.0, edges=np.array([[0, 99]]), progress=False)
+    with pytest.raises(ValueError, match="t0 <= end"):
+        pseudo_transient(problem, np.ones(problem.space.n_dofs), 0.5, t0=1.0, progress=False)
+    for bad in ({"damping": 0.0}, {"growth": 0.5}, {"max_strain_increment": -1.0}, {"atol": np.nan}):
+        with pytest.raises(ValueError, match="PseudoTransientOptions"):
+            PseudoTransientOptions(**bad)
+    # a trust region too tight to ever pass: the step shrinks below min_step and the error names where
+    options = PseudoTransientOptions(max_strain_increment=1e-9, min_step=1e-6, first_step=0.1, max_increment=None)
+    with pytest.raises(ConvergenceError, match=r"pseudo-step 1, load factor .*last accepted load factor 0") as info:
+        pseudo_transient(problem, np.ones(problem.space.n_dofs), 1.0, options, edges=np.array([[0, b]]),
+                         progress=False)
+    assert info.value.last_state.load_factor == 0.0 and info.value.last_state.rejected > 0
