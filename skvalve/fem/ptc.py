@@ -14,7 +14,8 @@ gradient-like flow :math:`c\,M\,\dot u = -R(u, t)`,
 
 with :math:`M` a diagonal of lumped nodal volumes (optionally plus :math:`\beta\,|\mathrm{diag}\,K_{ff}|/c`, a
 stiffness-proportional part), the load factor following pseudo-time up to ``end``
-(:math:`t_{k+1} = \min(\tau_k + \Delta\tau_k, t_\text{end})`, prescribed values and loads included) and held after. The step length follows switched evolution relaxation (SER),
+(:math:`t_{k+1} = \min(\tau_k + \Delta\tau_k, t_\text{end})`, prescribed values and loads included) and held after.
+The step length follows switched evolution relaxation (SER),
 :math:`\Delta\tau_{k+1} = \Delta\tau_k \min(g, \lVert R_k\rVert / \lVert R_{k+1}\rVert)`: while the residual
 falls the damping :math:`c/\Delta\tau` fades and the iteration becomes Newton's, converging quadratically to
 the undamped equilibrium. :math:`R` is always the undamped residual (the damping lives in the matrix only),
