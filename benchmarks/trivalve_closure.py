@@ -60,6 +60,7 @@ PTC_FLAGS = {
     "max_increment": (float, "trust region: largest nodal displacement change per step (mm)"),
     "first_step": (float, "first pseudo-time step"),
     "stiffness_damping": (float, "stiffness-proportional damping beta |diag K| / dtau"),
+    "local_damping": (float, "factor on the damping of nodes that break a trust region (1: off)"),
     "max_strain_increment": (float, "trust region: largest change of an edge's or cable's tensile stretch per step"),
 }
 

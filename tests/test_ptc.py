@@ -1,6 +1,8 @@
 """Pseudo-transient continuation (:mod:`skvalve.fem.ptc`): it converges to the undamped equilibrium that load-stepped
 Newton or a closed form gives, its trust regions hold on every accepted step, and bad input fails clearly."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import skfem
@@ -10,6 +12,7 @@ from skvalve.fem import NodalForce, Problem, Solid, Space, solve
 from skvalve.fem.damping import lumped_volume
 from skvalve.fem.errors import ConvergenceError
 from skvalve.fem.ptc import PseudoTransientOptions, pseudo_transient
+from skvalve.fem.terms import Blocks, Contribution, Term
 from skvalve.fem.truss import Truss
 from skvalve.materials import NeoHookean
 from skvalve.materials.uniaxial import OgdenUniaxial, TensionOnly
@@ -94,8 +97,64 @@ def test_slack_exponential_chord_against_the_closed_form_with_the_strain_trust_r
     taut_stretch = np.maximum(np.array(lengths) / 2.2, 1.0)
     assert np.abs(np.diff(taut_stretch)).max() <= 0.05 * (1 + 1e-12)  # the trust region held on every accepted step
     assert result.rejected > 0  # and had work to do
+    # local damping (the nodes that break the trust region are damped more, the step barely cut): same end state
+    problem, _, _ = _slack_chord(force)
+    local = pseudo_transient(problem, weights, 1.0, replace(options, local_damping=10.0), edges=np.array([[0, b]]),
+                             rest_lengths=[2.2], progress=False)
+    assert local.converged and (2.0 + local.u[3 * b]) / 2.2 == pytest.approx(stretch, rel=1e-10)
+    assert local.rejected > 0
     # without it, the first linearised step leaves the chord far beyond the root (what Newton's first iterate does)
     assert 0.1 * force / (0.33 * k_slack / 2.2) > 1e3
+
+
+class _JumpForce(Term):
+    """A dead force ``jump`` on one dof once it passes ``at`` (zero tangent): a discontinuity like a contact pair that
+    switches on at a finite overlap."""
+
+    load_dependent = False
+
+    def __init__(self, n_dofs: int, dof: int, at: float, jump: float) -> None:
+        self.n_dofs, self.dof, self.at, self.jump = n_dofs, dof, at, jump
+
+    def connectivity(self):
+        return [np.array([[self.dof]])]
+
+    def assemble(self, u, t, tangent, step):
+        external = np.zeros(self.n_dofs)
+        external[self.dof] = self.jump if u[self.dof] > self.at else 0.0
+        return Contribution(external=external, blocks=[Blocks(np.array([[self.dof]]),
+                                                               np.zeros((1, 1, 1)) if tangent else None)])
+
+
+def test_a_residual_jump_no_shorter_step_removes_is_crossed():
+    """A linear chord (k = A E / L) pulled by F, plus a force J switched on past u = 0.1: the residual jumps by J there
+    however short the step. Rejected at first, the crossing step is accepted once shorter than accept_jumps_below, and
+    the end state is the closed form u = (F + J) / k; with the option off, the run gives up with an error."""
+    from skvalve.materials.uniaxial import LinearUniaxial
+
+    def build():
+        space, a, b = _two_nodes()
+        chord = Truss(space, [[a, b]], 0.5, LinearUniaxial(4.0))
+        problem = Problem(space, [chord, NodalForce(space, np.array([b]), [0.4, 0.0, 0.0], ramp=True),
+                                  _JumpForce(space.n_dofs, 3 * b, 0.1, 0.3)])
+        problem.add_dirichlet(nodes=np.setdiff1d(np.arange(space.n_scalar), [b]), value=0.0)
+        problem.add_dirichlet(nodes=[b], value=0.0, components=[1, 2])
+        weights = np.zeros(space.n_dofs)
+        weights[3 * b] = 1.0
+        return problem, weights, b
+
+    problem, weights, b = build()
+    options = PseudoTransientOptions(damping=1.0, first_step=0.1, max_load_step=0.1, rtol=1e-12, atol=1e-14,
+                                     max_increment=None, accept_jumps_below=1e-4, min_step=1e-7, blow_up=2.0)
+    result = pseudo_transient(problem, weights, 1.0, options, progress=False)
+    k = 0.5 * 4.0 / 2.0
+    assert result.converged and result.rejected > 0
+    assert result.u[3 * b] == pytest.approx((0.4 + 0.3) / k, rel=1e-10)
+    problem, weights, b = build()
+    with pytest.raises(ConvergenceError, match="pseudo-time step fell"):
+        pseudo_transient(problem, weights, 1.0, PseudoTransientOptions(
+            damping=1.0, first_step=0.1, max_load_step=0.1, max_increment=None, accept_jumps_below=0.0,
+            min_step=1e-7, blow_up=2.0), progress=False)
 
 
 def test_bad_input_and_giving_up():

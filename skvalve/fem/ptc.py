@@ -72,6 +72,15 @@ class PseudoTransientOptions:
         displacement.
     blow_up : reject a step whose residual exceeds this multiple of the reference (the larger of the residual before
         the step and the linearised one with the new prescribed values).
+    local_damping, max_local_damping : when nodes break a trust region, their damping weights are multiplied by
+        ``local_damping`` (at most ``max_local_damping`` times their start value) and the step is retried only a
+        little shorter, instead of cutting the pseudo-time step for the whole problem by the factor the worst node
+        needs (the implicit analogue of an explicit code's selective mass scaling; the equilibrium does not depend on
+        the weights). 1: off.
+    accept_jumps_below : a step shorter than this is accepted even when its residual grows past ``blow_up`` (the
+        trust regions and the inversion test still apply): a growth that no shorter step removes is a
+        discontinuity of the problem — a contact pair that enters at a finite overlap — not an overshoot, and the
+        steps after it resolve it.
     rtol, atol : converged, once the load is at ``end``, when :math:`\lVert R_f\rVert \le \max(\text{rtol}
         \max(\lVert R_D\rVert, \lVert f_\text{ext}\rVert), \text{atol})`.
     max_steps : the most accepted pseudo-steps.
@@ -87,13 +96,20 @@ class PseudoTransientOptions:
     max_increment: float | None = 0.5
     max_strain_increment: float | None = 0.05
     blow_up: float = 10.0
+    accept_jumps_below: float = 1e-6
+    local_damping: float = 1.0
+    max_local_damping: float = 1e4
     rtol: float = 1e-6
     atol: float = 0.0
     max_steps: int = 5000
     solver: str | None = None
 
     def __post_init__(self) -> None:
-        positive = ("damping", "first_step", "min_step", "max_load_step", "growth", "load_growth", "blow_up", "rtol")
+        positive = ("damping", "first_step", "min_step", "max_load_step", "growth", "load_growth", "blow_up", "rtol",
+                    "local_damping", "max_local_damping")
+        if not (math.isfinite(self.accept_jumps_below) and self.accept_jumps_below >= 0):
+            raise ValueError("PseudoTransientOptions.accept_jumps_below must be finite and >= 0; "
+                             f"got {self.accept_jumps_below!r}")
         for name in positive:
             value = getattr(self, name)
             if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
@@ -167,13 +183,17 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
     opts = options or PseudoTransientOptions()
     solver = linsolve.solver_name(opts.solver)
     n = problem.space.n_dofs
-    weights = np.asarray(weights, dtype=float).ravel()
+    weights = np.array(weights, dtype=float).ravel()  # a copy: local damping raises entries of it
     if weights.shape != (n,) or not np.all(np.isfinite(weights) & (weights >= 0.0)):
         raise ValueError(f"weights must be {n} finite values >= 0")
     if not (math.isfinite(end) and end >= t0 >= 0.0):
         raise ValueError(f"need 0 <= t0 <= end; got t0={t0!r}, end={end!r}")
     if edges is not None:
         edges = _checked_edges(problem, edges, rest_lengths)
+    base = weights.copy()
+    positive = base[base > 0.0]
+    if positive.size:  # local damping needs a base weight on every displacement dof
+        base[: problem.space.n_u] = np.maximum(base[: problem.space.n_u], float(np.median(positive)) * 1e-3)
     problem.check_supports()
     pattern = problem.pattern
     fixed, free = pattern.fixed, pattern.free
@@ -212,6 +232,13 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
                 result.rejected += 1
                 failure = err.__cause__ if err.__cause__ is not None else err
                 factor = getattr(err, "factor", 0.25)
+                nodes = getattr(err, "nodes", None)
+                if opts.local_damping > 1.0 and nodes is not None and nodes.size:
+                    # damp the nodes that broke a trust region, not the whole problem (cf. selective mass scaling)
+                    dofs = problem.space.displacement_dofs(nodes).ravel()
+                    weights[dofs] = np.minimum(np.maximum(weights[dofs], base[dofs]) * opts.local_damping,
+                                               base[dofs] * opts.max_local_damping)
+                    factor = max(factor, 0.7)
                 logger.info("pseudo-step %d (t=%.5g, dtau=%.3g) rejected: %s", step, t_new, dtau, err)
                 if verbose:
                     print(f"  rejected pseudo-step {step} t={t_new:.5g} dtau={dtau:.3g}: {err}", flush=True)
@@ -284,19 +311,24 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
     du = np.zeros_like(u)
     du[free] = du_free
     space = problem.space
-    largest = float(np.max(np.linalg.norm(du[: space.n_u].reshape(-1, space.dim), axis=1), initial=0.0))
+    moves = np.linalg.norm(du[: space.n_u].reshape(-1, space.dim), axis=1)
+    largest = float(np.max(moves, initial=0.0))
     if opts.max_increment is not None and largest > opts.max_increment:
         rejected = _Rejected(f"a node would move {largest:.3g} > max_increment {opts.max_increment:g}")
         rejected.factor = max(0.1, 0.7 * opts.max_increment / largest)
+        rejected.nodes = np.flatnonzero(moves > opts.max_increment)
         raise rejected
     trial[free] += du_free
     if edges is not None and opts.max_strain_increment is not None and edges[0].size:
-        change, worst = _largest_stretch_change(edges[2], u, trial, edges[0], edges[1])
+        changes = _stretch_changes(edges[2], u, trial, edges[0], edges[1])
+        worst = int(np.argmax(changes))
+        change = float(changes[worst])
         if change > opts.max_strain_increment:
             a, b = edges[0][worst]
             rejected = _Rejected(f"the stretch of edge {a}-{b} would change by {change:.3g} > max_strain_increment "
                                  f"{opts.max_strain_increment:g}")
             rejected.factor = max(0.1, 0.7 * opts.max_strain_increment / change)
+            rejected.nodes = np.unique(edges[0][changes > opts.max_strain_increment])
             raise rejected
     clock = time.perf_counter()
     try:
@@ -307,23 +339,23 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
         timings["assembly"] += time.perf_counter() - clock
     trial_norm = float(np.linalg.norm(trial_residual[free]))
     reference = max(norm, float(np.linalg.norm(rhs[free])))
-    if not (trial_norm <= opts.blow_up * reference):
+    if not np.isfinite(trial_norm):
+        raise _Rejected("the residual is not finite")
+    if trial_norm > opts.blow_up * reference and dtau >= opts.accept_jumps_below:
         raise _Rejected(f"|R| grows from {reference:.3e} to {trial_norm:.3e}")
     return trial, trial_residual, trial_tangent, largest
 
 
-def _largest_stretch_change(X: np.ndarray, u: np.ndarray, trial: np.ndarray, edges: np.ndarray,
-                            rest: np.ndarray) -> tuple[float, int]:
-    r"""The largest change of an edge's tensile stretch :math:`\max(\ell/L, 1)` between ``u`` and ``trial``, and
-    that edge (``rest``: the lengths :math:`L` at which each edge starts to carry tension)."""
+def _stretch_changes(X: np.ndarray, u: np.ndarray, trial: np.ndarray, edges: np.ndarray,
+                     rest: np.ndarray) -> np.ndarray:
+    r"""The change of each edge's tensile stretch :math:`\max(\ell/L, 1)` between ``u`` and ``trial`` (``rest``: the
+    lengths :math:`L` at which each edge starts to carry tension)."""
     n = X.shape[0] * X.shape[1]
     before = X + u[:n].reshape(X.shape)
     after = X + trial[:n].reshape(X.shape)
     old = np.maximum(np.linalg.norm(before[edges[:, 1]] - before[edges[:, 0]], axis=1) / rest, 1.0)
     new = np.maximum(np.linalg.norm(after[edges[:, 1]] - after[edges[:, 0]], axis=1) / rest, 1.0)
-    change = np.abs(new - old)
-    worst = int(np.argmax(change)) if change.size else -1
-    return (float(change[worst]) if change.size else 0.0), worst
+    return np.abs(new - old)
 
 
 def _checked_edges(problem: Problem, edges, rest_lengths) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
