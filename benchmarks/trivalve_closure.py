@@ -20,11 +20,17 @@ from pathlib import Path
 
 import numpy as np
 
-from skvalve.fem.ptc import PseudoTransientOptions
 from skvalve.io.abaqus import read_model, trivalve_input
 from skvalve.io.files import replace_atomically
 from skvalve.papers.mathur2022.figures import write_figures
-from skvalve.valve.closure import ClosureOptions, closure_setup, relax_closure, run_closure, write_log
+from skvalve.valve.closure import (
+    ClosureOptions,
+    closure_setup,
+    relax_closure,
+    relaxation_options,
+    run_closure,
+    write_log,
+)
 from skvalve.valve.model import valve_model
 from skvalve.valve.outputs import ClosureWriter, closure_measures
 
@@ -60,6 +66,7 @@ PTC_FLAGS = {
     "max_increment": (float, "trust region: largest nodal displacement change per step (mm)"),
     "first_step": (float, "first pseudo-time step"),
     "stiffness_damping": (float, "stiffness-proportional damping beta |diag K| / dtau"),
+    "blow_up": (float, "reject a step whose residual grows more than this factor"),
     "local_damping": (float, "factor on the damping of nodes that break a trust region (1: off)"),
     "max_strain_increment": (float, "trust region: largest change of an edge's or cable's tensile stretch per step"),
 }
@@ -80,7 +87,7 @@ def main() -> int:
                         help="load-stepped Newton with damped steps, or pseudo-transient continuation (default)")
     for name, (kind, text) in PTC_FLAGS.items():
         parser.add_argument("--ptc-" + name.replace("_", "-"), type=kind, default=None,
-                            help=f"{text} (default: PseudoTransientOptions)")
+                            help=f"{text} (default: skvalve.valve.closure.relaxation_options)")
     parser.add_argument("--input", type=Path, default=None,
                         help="another TriValve input (.inp; default: the 1.0 diseased valve, $SKVALVE_TRIVALVE)")
     args = parser.parse_args()
@@ -106,8 +113,9 @@ def main() -> int:
     if overrides.get("max_increment") == 0.0:
         overrides["max_increment"] = None
     if args.method == "ptc":
-        overrides["damping"] = 0.0  # the pseudo-transient solver damps itself
-    options = ClosureOptions.for_model(model, **overrides)
+        options = ClosureOptions.for_relaxation(model, **overrides)
+    else:
+        options = ClosureOptions.for_model(model, **overrides)
     print(f"input {Path(path).name}: {options}", flush=True)
     setup = closure_setup(options=options, abaqus=abaqus, model=model)
     print("model:", setup.model.counts(), "contact faces:", setup.contact.surface.quads.shape[0], flush=True)
@@ -122,7 +130,9 @@ def main() -> int:
         setup.contact.active_pairs = logged_search
     if args.method == "ptc":
         ptc = {name: getattr(args, "ptc_" + name) for name in PTC_FLAGS if getattr(args, "ptc_" + name) is not None}
-        ptc_options = PseudoTransientOptions(rtol=options.rtol, atol=options.atol, **ptc)
+        ptc_options = relaxation_options(options.pressure_start, rtol=options.rtol, atol=options.atol, **ptc)
+        if ptc:  # flags set every stage's controls
+            ptc_options = [(until, replace(stage, **ptc)) for until, stage in ptc_options]
         print(f"pseudo-transient continuation: {ptc_options}", flush=True)
         run = relax_closure(setup, options.end, ptc_options, callbacks=[LastState(args.out)], progress=False,
                             verbose=args.verbose, u0=u0, t0=t0)

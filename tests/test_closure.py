@@ -20,10 +20,12 @@ from skvalve.papers.mathur2022 import reproduce as reproduce_module
 from skvalve.valve.closure import (
     ClosureOptions,
     ClosureSetup,
+    EveryLoadFactor,
     _PenaltyFrom,
     contact_surface,
     load_factors,
     relax_closure,
+    relaxation_options,
     run_closure,
 )
 from skvalve.valve.model import valve_model
@@ -99,6 +101,24 @@ def test_contact_pairs_closer_than_exclude_within_in_the_reference_are_never_act
     assert contact.active_pairs(u).size == 0
     with pytest.raises(ValueError, match="exclude_within"):
         SurfaceContact(setup.problem.space, contact.surface, 1.0, exclude_within=-1.0)
+
+
+def test_relaxation_controls_and_sampled_output():
+    """The valve's pseudo-transient stages: the papillary stage with a tight stretch trust region and nothing else,
+    the pressure stage with stiffness-proportional and local damping and the overrides. The output sampler passes one
+    event per 0.05 of load factor, whatever the step count."""
+    (until, first), (last_until, last) = relaxation_options(0.5, rtol=1e-7)
+    assert until == 0.5 and first.max_strain_increment == 0.05 and first.stiffness_damping == 0.0
+    assert first.local_damping == 1.0 and first.rtol == 1e-3
+    assert last_until == np.inf and last.rtol == 1e-7 and last.stiffness_damping == 1e-3 and last.local_damping == 10
+    assert len(relaxation_options(0.0)) == 1  # everything ramps together: one stage
+    seen = []
+    sampler = EveryLoadFactor(lambda event: seen.append(event.load_factor), 0.05)
+    for t in np.concatenate([np.linspace(0.0, 0.2, 81), np.full(5, 0.2)]):
+        sampler(SimpleNamespace(load_factor=float(t)))
+    assert seen == pytest.approx([0.0, 0.05, 0.1, 0.15, 0.2])
+    with pytest.raises(ValueError, match="spacing"):
+        EveryLoadFactor(print, 0.0)
 
 
 def test_contact_penalty_switches_on_by_a_smooth_step():

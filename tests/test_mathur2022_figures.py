@@ -160,13 +160,16 @@ def test_reproduce_full_writes_the_figures_of_the_last_state(setup, tmp_path, mo
     """The --full path with the closure replaced by a run that stopped at the open configuration."""
     module = reproduce_module
 
-    def stopped(setup, options, callbacks=(), progress=True):
+    def stopped(setup, end, options, callbacks=(), progress=True):
         return ClosureRun(load_factors=[0.0], iterations=[0], contact_pairs=[0],
                           u=np.zeros(setup.problem.space.n_dofs), error="stopped for the test")
 
-    monkeypatch.setattr(module, "closure_setup", lambda path, options: setup)
-    monkeypatch.setattr(module, "run_closure", stopped)
+    monkeypatch.setattr(module, "read_model", lambda path: setup.abaqus)
+    monkeypatch.setattr(module, "valve_model", lambda abaqus: setup.model)
+    monkeypatch.setattr(module, "closure_setup", lambda options, abaqus, model: setup)
+    monkeypatch.setattr(module, "relax_closure", stopped)
     items = list(module.reproduce(tmp_path, full=True))
+    assert (tmp_path / "mathur2022_closure.pvd").exists() and (tmp_path / "mathur2022_closure_0000.vtu").exists()
     names = ("mathur2022_atrial_stress.png", "mathur2022_coaptation.png", "mathur2022_orifice.png")
     for name in names:
         assert _png_width(tmp_path / name) >= 600

@@ -49,6 +49,14 @@ def test_relaxes_to_the_equilibrium_newton_reaches():
     assert result.step_lengths[held[-1]] > 10 * result.step_lengths[held[0]]
     assert result.residuals[-1] < 1e-6 * max(result.residuals)
     assert [event.step for event in seen] == list(range(1, len(result.pseudo_times) + 1))
+    # a stiffness-proportional damping (here a function of the load factor) changes the path, not the end state
+    block = _sheared_block()
+    damped = pseudo_transient(block, lumped_volume(block.space), 1.0,
+                              PseudoTransientOptions(damping=1.0, first_step=0.05, max_load_step=0.1, rtol=1e-11,
+                                                     max_increment=None, stiffness_damping=lambda t: 0.05 * t),
+                              progress=False)
+    assert damped.converged and np.abs(damped.u - newton.u()).max() <= 1e-9 * np.abs(newton.u()).max()
+    assert damped.step_lengths != result.step_lengths
 
 
 def _two_nodes(L: float = 2.0):

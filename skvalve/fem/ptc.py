@@ -58,7 +58,8 @@ class PseudoTransientOptions:
         :math:`\beta\,|\mathrm{diag}\,K_{ff}|/\Delta\tau` (Rayleigh's stiffness-proportional part, dimensionless
         times pseudo-time): it damps most where the material is stiffest, which is where an element driven far
         into an exponential law loses stability (modes with negative curvature that a volume-proportional damping
-        of the soft leaflet cannot hold without tiny steps everywhere). Zero: off.
+        of the soft leaflet cannot hold without tiny steps everywhere). Zero: off; a callable: a function of the load
+        factor.
     first_step, min_step : the first :math:`\Delta\tau`, and the smallest before giving up.
     max_load_step : the largest :math:`\Delta\tau` while the load factor still moves (the load path's resolution).
     growth : the largest SER growth of :math:`\Delta\tau` per step once the load is held.
@@ -87,7 +88,7 @@ class PseudoTransientOptions:
     """
 
     damping: float = 1e-4
-    stiffness_damping: float = 0.0
+    stiffness_damping: float | Callable[[float], float] = 0.0
     first_step: float = 1e-3
     min_step: float = 1e-9
     max_load_step: float = 0.01
@@ -121,7 +122,8 @@ class PseudoTransientOptions:
                                                           and self.max_strain_increment > 0):
             raise ValueError("PseudoTransientOptions.max_strain_increment must be None or positive; "
                              f"got {self.max_strain_increment!r}")
-        if not (math.isfinite(self.stiffness_damping) and self.stiffness_damping >= 0):
+        if not callable(self.stiffness_damping) and not (math.isfinite(self.stiffness_damping)
+                                                         and self.stiffness_damping >= 0):
             raise ValueError("PseudoTransientOptions.stiffness_damping must be finite and >= 0; "
                              f"got {self.stiffness_damping!r}")
         if not (math.isfinite(self.atol) and self.atol >= 0):
@@ -295,8 +297,11 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
         trial[fixed] = new_values
     K = problem.tangent_matrix(tangent)
     diagonal = opts.damping * weights[free]
-    if opts.stiffness_damping > 0.0:
-        diagonal = diagonal + opts.stiffness_damping * np.abs(K.diagonal())
+    beta = float(opts.stiffness_damping(t_new)) if callable(opts.stiffness_damping) else opts.stiffness_damping
+    if not (math.isfinite(beta) and beta >= 0.0):
+        raise ValueError(f"stiffness_damping must be finite and >= 0; got {beta!r} at load factor {t_new}")
+    if beta > 0.0:
+        diagonal = diagonal + beta * np.abs(K.diagonal())
     K = K + sp.diags(diagonal / dtau, format="csr")
     timings["assembly"] += time.perf_counter() - clock
     clock = time.perf_counter()

@@ -8,8 +8,8 @@ end-systolic one; it measures the leaflet areas of the open configuration (repor
 end-systolic values, with that difference stated). It does **not** close the valve: on 2 cores the full
 closure takes far longer than a default run (``benchmarks/trivalve_closure.py``).
 
-``full=True``: the implicit closure from the open configuration to end-systole
-(:func:`skvalve.valve.closure.run_closure`) and all Table 2 (orifice, leaflet, coaptation area) and
+``full=True``: the implicit closure from the open configuration to end-systole by pseudo-transient continuation
+(:func:`skvalve.valve.closure.relax_closure`) and all Table 2 (orifice, leaflet, coaptation area) and
 Table 3 (centre stresses) rows of the diseased column, with a VTU series and the figures of
 :mod:`skvalve.papers.mathur2022.figures` in ``out``. When the closure stops
 early, the rows are those of the last converged state, marked with the step time reached.
@@ -26,8 +26,16 @@ from pathlib import Path
 
 import numpy as np
 
-from ...io.abaqus import trivalve_input
-from ...valve.closure import ClosureOptions, closure_setup, run_closure, write_log
+from ...io.abaqus import read_model, trivalve_input
+from ...valve.closure import (
+    ClosureOptions,
+    EveryLoadFactor,
+    closure_setup,
+    relax_closure,
+    relaxation_options,
+    write_log,
+)
+from ...valve.model import valve_model
 from ...valve.outputs import ClosureWriter, closure_measures
 from ..table import Reason, Row, Stage, Written
 from .data import CREDIT, TABLE2_AREAS, TABLE3_CENTRE_STRESS
@@ -54,9 +62,11 @@ def _require_input() -> Path:
 def reproduce(out: Path | None = None, full: bool = False) -> Iterator[Row | Stage | Written]:
     """Yield the Table 2–3 rows (module docstring); exits with code 2 when the shipped input is absent."""
     path = _require_input()
-    options = ClosureOptions()
     yield Stage(f"reading {path.name} and building the implicit model with contact ({CREDIT})")
-    setup = closure_setup(path, options)
+    abaqus = read_model(path)
+    model = valve_model(abaqus)
+    options = ClosureOptions.for_relaxation(model)
+    setup = closure_setup(options=options, abaqus=abaqus, model=model)
     yield Stage("Table 2 measures of the open (reference) configuration")
     reference = closure_measures(setup, np.zeros(setup.problem.space.n_dofs), 0.0)
     yield Row("Table 2 orifice area, diseased (mm²; annulus held)", TABLE2_AREAS["orifice"].diseased,
@@ -69,13 +79,17 @@ def reproduce(out: Path | None = None, full: bool = False) -> Iterator[Row | Sta
                   note="mid-surface area of the open, unloaded leaflets: the default run does not close the valve "
                        "(use --full); the paper's value is at end-systole")
         return
-    yield Stage("implicit closure: papillary motion 0-0.5, pressure 0.5-1.5 (long: see benchmarks/"
-                "trivalve_closure.py)")
-    callbacks = [] if out is None else [ClosureWriter(Path(out) / "mathur2022_closure.pvd", setup)]
-    run = run_closure(setup, options, callbacks=callbacks, progress=True)
+    yield Stage("implicit closure by pseudo-transient continuation: papillary motion 0-0.5, pressure 0.5-1.5 "
+                "(long: see benchmarks/trivalve_closure.py)")
+    writer = None if out is None else ClosureWriter(Path(out) / "mathur2022_closure.pvd", setup)
+    callbacks = [] if writer is None else [EveryLoadFactor(writer, 0.05)]
+    controls = relaxation_options(options.pressure_start, rtol=options.rtol, atol=options.atol)
+    run = relax_closure(setup, options.end, controls, callbacks=callbacks, progress=True)
+    reached = run.load_factors[-1] if run.load_factors else 0.0
     if out is not None:
         write_log(run, Path(out) / "mathur2022_closure_log.txt")
-    reached = run.load_factors[-1] if run.load_factors else 0.0
+        if run.u is not None:
+            writer.write(reached, run.u)  # the last state, whatever the sampling kept
     complete = run.error is None and reached >= options.end
     state = "end-systole" if complete else f"stopped at step time {reached:.3g} of 1.5 ({run.error})"
     yield Stage(f"closure {state}; undamped residual (norm, relative) {run.undamped_residual}")
