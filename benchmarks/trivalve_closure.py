@@ -20,11 +20,13 @@ from pathlib import Path
 
 import numpy as np
 
+from skvalve.fem.damping import undamped_residual
 from skvalve.io.abaqus import read_model, trivalve_input
 from skvalve.io.files import replace_atomically
 from skvalve.papers.mathur2022.figures import write_figures
 from skvalve.valve.closure import (
     ClosureOptions,
+    ClosureRun,
     closure_setup,
     relax_closure,
     relaxation_options,
@@ -65,6 +67,7 @@ PTC_FLAGS = {
     "max_load_step": (float, "largest pseudo-time step while the load moves"),
     "max_increment": (float, "trust region: largest nodal displacement change per step (mm)"),
     "first_step": (float, "first pseudo-time step"),
+    "max_steps": (int, "the most accepted pseudo-steps"),
     "stiffness_damping": (float, "stiffness-proportional damping beta |diag K| / dtau"),
     "blow_up": (float, "reject a step whose residual grows more than this factor"),
     "local_damping": (float, "factor on the damping of nodes that break a trust region (1: off)"),
@@ -78,6 +81,8 @@ def main() -> int:
     parser.add_argument("--end", type=float, default=None, help="last step time (default: the input's step time)")
     parser.add_argument("--verbose", action="store_true", help="one line per Newton iteration")
     parser.add_argument("--resume", action="store_true", help="start from --out/last_state.npz")
+    parser.add_argument("--report", action="store_true",
+                        help="with --resume: measure and draw the kept state (Table 2-3 rows, figures, VTU), no solve")
     for name, (kind, text) in OPTION_FLAGS.items():
         parser.add_argument("--" + name.replace("_", "-"), type=kind, default=None,
                             help=f"{text} (default: ClosureOptions.for_model)")
@@ -91,6 +96,8 @@ def main() -> int:
     parser.add_argument("--input", type=Path, default=None,
                         help="another TriValve input (.inp; default: the 1.0 diseased valve, $SKVALVE_TRIVALVE)")
     args = parser.parse_args()
+    if args.report and not args.resume:
+        parser.error("--report needs --resume")
     path = trivalve_input() if args.input is None else args.input
     if path is None or not Path(path).exists():
         print("Texas TriValve input not found: set $SKVALVE_TRIVALVE (Mathur et al. 2022, CC BY-NC-SA 4.0)")
@@ -128,7 +135,12 @@ def main() -> int:
             return pairs
 
         setup.contact.active_pairs = logged_search
-    if args.method == "ptc":
+    if args.report:  # the kept state, measured and drawn, no solve
+        run = ClosureRun(load_factors=[t0], iterations=[0], u=u0)
+        setup.contact.assemble(u0, t0, False, None)
+        run.contact_pairs = [setup.contact.last_pairs.size]
+        run.undamped_residual = undamped_residual(setup.problem, u0, t0)
+    elif args.method == "ptc":
         ptc = {name: getattr(args, "ptc_" + name) for name in PTC_FLAGS if getattr(args, "ptc_" + name) is not None}
         ptc_options = relaxation_options(options.pressure_start, rtol=options.rtol, atol=options.atol, **ptc)
         if ptc:  # flags set every stage's controls
@@ -139,7 +151,7 @@ def main() -> int:
     else:
         run = run_closure(setup, options, callbacks=[LastState(args.out)], progress=False, verbose=args.verbose,
                           u0=u0, t0=t0)
-    write_log(run, args.out / "closure_log.txt")
+    write_log(run, args.out / ("report_log.txt" if args.report else "closure_log.txt"))
     print(f"wall time {run.seconds:.1f} s, load steps {len(run.load_factors) - 1}, "
           f"Newton iterations {sum(run.iterations)}, contact pairs at the end "
           f"{run.contact_pairs[-1] if run.contact_pairs else 0}, peak memory {run.peak_memory_mb:.0f} MB")

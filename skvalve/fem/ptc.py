@@ -77,7 +77,8 @@ class PseudoTransientOptions:
         ``local_damping`` (at most ``max_local_damping`` times their start value) and the step is retried only a
         little shorter, instead of cutting the pseudo-time step for the whole problem by the factor the worst node
         needs (the implicit analogue of an explicit code's selective mass scaling; the equilibrium does not depend on
-        the weights). 1: off.
+        the weights). 1: off. After each accepted step the raised weights fall by ``local_decay`` towards their start
+        values (kept, the frozen nodes' residual stalls the final relaxation).
     accept_jumps_below : a step shorter than this is accepted even when its residual grows past ``blow_up`` (the
         trust regions and the inversion test still apply): a growth that no shorter step removes is a
         discontinuity of the problem — a contact pair that enters at a finite overlap — not an overshoot, and the
@@ -100,6 +101,7 @@ class PseudoTransientOptions:
     accept_jumps_below: float = 1e-6
     local_damping: float = 1.0
     max_local_damping: float = 1e4
+    local_decay: float = 0.5
     rtol: float = 1e-6
     atol: float = 0.0
     max_steps: int = 5000
@@ -128,6 +130,8 @@ class PseudoTransientOptions:
                              f"got {self.stiffness_damping!r}")
         if not (math.isfinite(self.atol) and self.atol >= 0):
             raise ValueError(f"PseudoTransientOptions.atol must be finite and >= 0; got {self.atol!r}")
+        if not 0.0 < self.local_decay <= 1.0:
+            raise ValueError(f"PseudoTransientOptions.local_decay must lie in (0, 1]; got {self.local_decay!r}")
         if self.growth < 1.0 or self.load_growth < 1.0:
             raise ValueError(f"PseudoTransientOptions.growth and load_growth must be >= 1; got {self.growth!r}, "
                              f"{self.load_growth!r}")
@@ -192,7 +196,7 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
         raise ValueError(f"need 0 <= t0 <= end; got t0={t0!r}, end={end!r}")
     if edges is not None:
         edges = _checked_edges(problem, edges, rest_lengths)
-    base = weights.copy()
+    original, base = weights.copy(), weights.copy()
     positive = base[base > 0.0]
     if positive.size:  # local damping needs a base weight on every displacement dof
         base[: problem.space.n_u] = np.maximum(base[: problem.space.n_u], float(np.median(positive)) * 1e-3)
@@ -247,6 +251,8 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
                 dtau *= factor
                 continue
             problem.commit()
+            if opts.local_damping > 1.0:  # boosts fade: a node damped for one hard step must not stay frozen
+                np.maximum(original, weights * opts.local_decay, out=weights)
             previous = norm
             u, residual, tangent = trial, trial_residual, trial_tangent
             norm = float(np.linalg.norm(residual[free]))
