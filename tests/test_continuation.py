@@ -4,8 +4,9 @@
 import numpy as np
 import pytest
 import skfem
+from _truss_checks import two_nodes
 
-from skvalve.fem import NodalForce, Problem, Solid, Space, solve
+from skvalve.fem import NodalForce, Problem, Solid, solve
 from skvalve.fem.amplitudes import GeometricRamp, smooth_step_polynomial
 from skvalve.fem.truss import Truss
 from skvalve.materials import NeoHookean
@@ -29,16 +30,8 @@ def test_geometric_ramp_endpoints_midpoint_and_monotone():
             GeometricRamp(*bad)
 
 
-def _two_nodes(L: float = 2.0):
-    space = Space(skfem.MeshHex().scaled([L, L, L]))
-    X = space.dof_coordinates
-    a = int(np.flatnonzero(np.all(np.isclose(X, 0.0), axis=0))[0])
-    b = int(np.flatnonzero(np.isclose(X[0], L) & np.isclose(X[1], 0) & np.isclose(X[2], 0))[0])
-    return space, a, b
-
-
 def test_stiffness_scale_multiplies_forces_and_tangent():
-    space, a, b = _two_nodes()
+    space, a, b = two_nodes()
     scale = 0.037
     scaled = Truss(space, [[a, b]], 0.3, LinearUniaxial(5.0), stiffness_scale=lambda t: scale * (1 + t))
     plain = Truss(space, [[a, b]], 0.3, LinearUniaxial(5.0))
@@ -53,7 +46,7 @@ def test_stiffness_scale_multiplies_forces_and_tangent():
 
 def test_scaled_chord_against_closed_form():
     """A linear chord with scale s pulled by F: s A E (lambda - 1) = F."""
-    space, a, b = _two_nodes()
+    space, a, b = two_nodes()
     area, modulus, force, scale = 0.2, 10.0, 0.05, 1e-2
     problem = Problem(space, [Truss(space, [[a, b]], area, LinearUniaxial(modulus), stiffness_scale=lambda t: scale)])
     problem.add_dirichlet(nodes=np.setdiff1d(np.arange(space.n_scalar), [b]), value=0.0)
@@ -110,7 +103,7 @@ def test_stiffness_scale_softens_the_taut_law_and_keeps_the_slack_spring():
     assert np.allclose(Ps, expected, rtol=1e-14, atol=1e-16)
     assert np.allclose(Ps[:2], P1[:2], rtol=1e-14) and np.allclose(dPs[:2], k, rtol=1e-14)
     assert np.allclose(dPs[2:], k + 0.01 * 100.0, rtol=1e-14)
-    space, a, b = _two_nodes()
+    space, a, b = two_nodes()
     truss = Truss(space, [[a, b]], 0.5, cable, rest_length=[2.2], slack_stretch=[2.0 / 2.2],
                   stiffness_scale=lambda t: 0.01)
     u = np.zeros(space.n_dofs)

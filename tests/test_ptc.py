@@ -6,9 +6,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 import skfem
+from _truss_checks import two_nodes
 from scipy.optimize import brentq
 
-from skvalve.fem import NodalForce, Problem, Solid, Space, solve
+from skvalve.fem import NodalForce, Problem, Solid, solve
 from skvalve.fem.damping import lumped_volume
 from skvalve.fem.errors import ConvergenceError
 from skvalve.fem.ptc import PseudoTransientOptions, pseudo_transient
@@ -59,18 +60,10 @@ def test_relaxes_to_the_equilibrium_newton_reaches():
     assert damped.step_lengths != result.step_lengths
 
 
-def _two_nodes(L: float = 2.0):
-    space = Space(skfem.MeshHex().scaled([L, L, L]))
-    X = space.dof_coordinates
-    a = int(np.flatnonzero(np.all(np.isclose(X, 0.0), axis=0))[0])
-    b = int(np.flatnonzero(np.isclose(X[0], L) & np.isclose(X[1], 0) & np.isclose(X[2], 0))[0])
-    return space, a, b
-
-
 def _slack_chord(force: float):
     """An Ogden chord (alpha = 50, as the tricuspid chordae) from a fixed node to a node 2 away that a force pulls
     along the chord; rest length 2.2: slack at the start, held only by its slack spring (1e-6 of the modulus)."""
-    space, a, b = _two_nodes()
+    space, a, b = two_nodes()
     law = OgdenUniaxial((4.0, 15.0), (50.0, 50.0))
     chord = Truss(space, [[a, b]], 0.33, TensionOnly(law, slack_fraction=1e-6), rest_length=[2.2],
                   slack_stretch=[2.0 / 2.2])
@@ -141,7 +134,7 @@ def test_a_residual_jump_no_shorter_step_removes_is_crossed():
     from skvalve.materials.uniaxial import LinearUniaxial
 
     def build():
-        space, a, b = _two_nodes()
+        space, a, b = two_nodes()
         chord = Truss(space, [[a, b]], 0.5, LinearUniaxial(4.0))
         problem = Problem(space, [chord, NodalForce(space, np.array([b]), [0.4, 0.0, 0.0], ramp=True),
                                   _JumpForce(space.n_dofs, 3 * b, 0.1, 0.3)])
