@@ -606,10 +606,16 @@ if HAVE_DATA:
 #
 # * `skvalve reproduce mathur2022` compares the orifice and leaflet areas of the open configuration with Table 2
 #   (minutes); `skvalve reproduce mathur2022 --full --out out/` runs the implicit closure of the whole diseased valve
-#   with leaflet contact (`skvalve.valve.closure.run_closure`: all three leaflets, 690 cables,
-#   `SurfaceContact` on the input's contact surfaces, vanishing damping) and prints all Table 2–3 rows of the
-#   diseased column, with a VTU/PVD series for ParaView.
-# * `benchmarks/trivalve_closure.py --out DIR` runs the same closure and reports wall time, load steps, Newton
-#   iterations, contact pairs and peak memory (`--resume` restarts from the last converged state kept on disk).
+#   with leaflet contact (`skvalve.valve.closure.relax_closure`: all three leaflets, 690 cables at their full law,
+#   `SurfaceContact` on the input's contact surfaces) by *pseudo-transient continuation* (`skvalve.fem.ptc`): one
+#   damped, linearised implicit-Euler step per pseudo-time step, no equilibrium asked for on the way, trust regions
+#   on nodal motion and on the tensile stretch of every hex edge and cable (the linear step from the toe of an
+#   exponential law into its steep part is what overshoots), and at the end the damping fades (switched evolution
+#   relaxation) so that the last steps are Newton's on the undamped problem. It prints all Table 2–3 rows of the
+#   diseased column, with a VTU/PVD series for ParaView. The load-stepped Newton closure of this section
+#   (`run_closure`, soft chords, converged damped steps) stalls in the tethering stage of the whole valve.
+# * `benchmarks/trivalve_closure.py --out DIR` runs the same closure and reports wall time, pseudo-steps, rejected
+#   steps, contact pairs and peak memory (`--resume` restarts from the last state kept on disk; `--resume --report`
+#   measures and draws it).
 #
 # Both need the authors' input files (`$SKVALVE_TRIVALVE`) and take far longer than this notebook on two cores.
