@@ -45,6 +45,7 @@ OPTION_FLAGS = {
     "max_increment": (float, "cap (mm) on a node's displacement change per Newton iteration; 0: none"),
     "regularization": (float, "initial Levenberg-Marquardt shift of the tangent per step (0: plain Newton)"),
     "cable_softening": (float, "initial scale of the chordae's taut law (1: none)"),
+    "cable_slack_fraction": (float, "cable stiffness below the slack length, relative to the small-strain modulus"),
     "contact_from": (float, "step time from which the contact penalty acts"),
     "contact_exclude_within": (float, "node-face pairs closer than this (mm) in the reference never contact"),
     "contact_ramp": (float, "step-time interval over which the contact penalty rises smoothly to its value"),

@@ -53,39 +53,51 @@ logger = logging.getLogger("skvalve.fem")
 class PseudoTransientOptions:
     r"""Controls of :func:`pseudo_transient` (units of the problem).
 
-    damping : :math:`c`, the coefficient of :math:`M/\Delta\tau` (force per volume per length per unit pseudo-time).
-    stiffness_damping : :math:`\beta`, a damping proportional to the tangent's diagonal,
-        :math:`\beta\,|\mathrm{diag}\,K_{ff}|/\Delta\tau` (Rayleigh's stiffness-proportional part, dimensionless
-        times pseudo-time): it damps most where the material is stiffest, which is where an element driven far
-        into an exponential law loses stability (modes with negative curvature that a volume-proportional damping
-        of the soft leaflet cannot hold without tiny steps everywhere). Zero: off; a callable: a function of the load
+    Attributes
+    ----------
+    damping : float
+        :math:`c`, the coefficient of :math:`M/\Delta\tau` (force per volume per length per unit pseudo-time).
+    stiffness_damping : float or callable
+        :math:`\beta`, a damping :math:`\beta\,|\mathrm{diag}\,K_{ff}|/\Delta\tau` proportional to the tangent's
+        diagonal (Rayleigh's stiffness-proportional part): it damps most where the material is stiffest, which is where
+        an element driven far into an exponential law loses stability. Zero: off; a callable: a function of the load
         factor.
-    first_step, min_step : the first :math:`\Delta\tau`, and the smallest before giving up.
-    max_load_step : the largest :math:`\Delta\tau` while the load factor still moves (the load path's resolution).
-    growth : the largest SER growth of :math:`\Delta\tau` per step once the load is held.
-    load_growth : the growth of :math:`\Delta\tau` per accepted step while the load moves (back towards
-        ``max_load_step`` after a cut; a gentle value wastes fewer rejected steps on a path whose trust regions bind).
-    max_increment : trust region: the largest nodal displacement change in one step (length), ``None``: off.
-    max_strain_increment : trust region on the ``edges`` given to :func:`pseudo_transient`: the largest change of an
-        edge's tensile stretch :math:`\max(\ell/L, 1)` in one step (``None``: off; slack cables and shortening edges
-        move freely). Exponential laws (collagenous leaflets, chordae) need it: a linearised step taken from the
-        flat toe of such a law into its steep part overshoots by orders of magnitude, however small the nodal
-        displacement.
-    blow_up : reject a step whose residual exceeds this multiple of the reference (the larger of the residual before
-        the step and the linearised one with the new prescribed values).
-    local_damping, max_local_damping : when nodes break a trust region, their damping weights are multiplied by
-        ``local_damping`` (at most ``max_local_damping`` times their start value) and the step is retried only a
-        little shorter, instead of cutting the pseudo-time step for the whole problem by the factor the worst node
-        needs (the implicit analogue of an explicit code's selective mass scaling; the equilibrium does not depend on
-        the weights). 1: off. After each accepted step the raised weights fall by ``local_decay`` towards their start
-        values (kept, the frozen nodes' residual stalls the final relaxation).
-    accept_jumps_below : a step shorter than this is accepted even when its residual grows past ``blow_up`` (the
-        trust regions and the inversion test still apply): a growth that no shorter step removes is a
-        discontinuity of the problem — a contact pair that enters at a finite overlap — not an overshoot, and the
-        steps after it resolve it.
-    rtol, atol : converged, once the load is at ``end``, when :math:`\lVert R_f\rVert \le \max(\text{rtol}
-        \max(\lVert R_D\rVert, \lVert f_\text{ext}\rVert), \text{atol})`.
-    max_steps : the most accepted pseudo-steps.
+    first_step, min_step : float
+        The first :math:`\Delta\tau`, and the smallest before giving up.
+    max_load_step : float
+        The largest :math:`\Delta\tau` while the load factor still moves (the load path's resolution).
+    growth : float
+        The largest SER growth of :math:`\Delta\tau` per step once the load is held.
+    load_growth : float
+        The growth of :math:`\Delta\tau` per accepted step while the load moves (back towards ``max_load_step``
+        after a cut; a gentle value wastes fewer rejected steps on a path whose trust regions bind).
+    max_increment : float or None
+        Trust region: the largest nodal displacement change in one step (length); ``None``: off.
+    max_strain_increment : float or None
+        Trust region on the ``edges`` given to :func:`pseudo_transient`: the largest change of an edge's tensile
+        stretch :math:`\max(\ell/L, 1)` in one step (``None``: off; slack cables and shortening edges move freely).
+        Exponential laws (collagenous leaflets, chordae) need it: a linearised step taken from the flat toe of such a
+        law into its steep part overshoots by orders of magnitude, however small the nodal displacement.
+    blow_up : float
+        Reject a step whose residual exceeds this multiple of the reference (the larger of the residual before the
+        step and the linearised one with the new prescribed values).
+    accept_jumps_below : float
+        A step shorter than this is accepted even when its residual grows past ``blow_up`` (the trust regions and the
+        inversion test still apply): a growth that no shorter step removes is a discontinuity of the problem (a
+        contact pair that enters at a finite overlap), not an overshoot, and the steps after it resolve it.
+    local_damping, max_local_damping, local_decay : float
+        When nodes break a trust region, their damping weights are multiplied by ``local_damping`` (at most
+        ``max_local_damping`` times their start value) and the step is retried only a little shorter, instead of
+        cutting the pseudo-time step for the whole problem by the factor the worst node needs (the implicit analogue
+        of an explicit code's selective mass scaling; the equilibrium does not depend on the weights); after each
+        accepted step the raised weights fall by ``local_decay`` towards their start values. 1: off.
+    rtol, atol : float
+        Converged, once the load is at ``end``, when the free residual is at most the larger of ``atol`` and
+        ``rtol`` times the larger of the reactions' and the external forces' norms.
+    max_steps : int
+        The most accepted pseudo-steps.
+    solver : str or None
+        Sparse backend (:func:`skvalve.fem.linsolve.solver_name`).
     """
 
     damping: float = 1e-4

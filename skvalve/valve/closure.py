@@ -66,6 +66,8 @@ class ClosureOptions:
     pressure_damping : :math:`c_0` from ``pressure_start`` on, decaying to zero at ``damping_off``
     (:class:`StagedDamping`): the leaflets under the first, tiny pressures are nearly free, and nothing prescribed
     drags them there, so they take far more damping than the papillary stage does.
+    cable_slack_fraction : the cables' stiffness below their slack length, relative to their small-strain modulus
+    (:meth:`~skvalve.valve.model.ValveModel.problem`; Abaqus's T3D2 chordae resist compression with their full law).
     contact_exclude_within : node-face pairs whose reference distance is below this never contact
     (:class:`~skvalve.fem.contact.SurfaceContact` ``exclude_within``; on the 1.0 valve the only pairs of the papillary
     stage were rim nodes against the inner face of their own leaflet 0.5 mm away, across the 0.78 mm thick corner).
@@ -111,6 +113,7 @@ class ClosureOptions:
     contact_from: float = 0.5
     contact_ramp: float = 0.0
     contact_exclude_within: float = 0.0
+    cable_slack_fraction: float = 1e-6
     pressure_damping: float = 1e-4
 
     @classmethod
@@ -190,7 +193,7 @@ def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: Abaq
                                     "folder (model files of Mathur et al. 2022, CC BY-NC-SA 4.0)")
         abaqus = read_model(path)
     model = valve_model(abaqus) if model is None else model
-    problem = model.problem(insertion=options.insertion)
+    problem = model.problem(insertion=options.insertion, slack_fraction=options.cable_slack_fraction)
     if options.cable_softening != 1.0:
         ramp = GeometricRamp(options.cable_softening, *options.cable_stiffening)
         for term in problem.terms:
