@@ -158,6 +158,18 @@ def test_a_residual_jump_no_shorter_step_removes_is_crossed():
             min_step=1e-7, blow_up=2.0), progress=False)
 
 
+def test_a_stalled_relaxation_gives_up_with_its_last_state():
+    """A pseudo-step so short that the held residual cannot halve in 5 steps: the run stops, naming the stall."""
+    problem, _, b = _slack_chord(2.0)
+    weights = np.zeros(problem.space.n_dofs)
+    weights[3 * b] = 1.0
+    options = PseudoTransientOptions(damping=1e3, first_step=0.5, max_load_step=0.5, growth=1.0, stall_steps=5,
+                                     max_increment=None)
+    with pytest.raises(ConvergenceError, match="stalled") as info:
+        pseudo_transient(problem, weights, 1.0, options, progress=False)
+    assert info.value.last_state.load_factor == 1.0 and not info.value.last_state.converged
+
+
 def test_bad_input_and_giving_up():
     problem, _, b = _slack_chord(2.0)
     with pytest.raises(ValueError, match="weights must be"):

@@ -96,6 +96,9 @@ class PseudoTransientOptions:
         ``rtol`` times the larger of the reactions' and the external forces' norms.
     max_steps : int
         The most accepted pseudo-steps.
+    stall_steps : int
+        Give up (``ConvergenceError``, last state kept) when, with the load held at ``end``, the residual has not
+        fallen below half its value of ``stall_steps`` steps before (0: never).
     solver : str or None
         Sparse backend (:func:`skvalve.fem.linsolve.solver_name`).
     """
@@ -117,6 +120,7 @@ class PseudoTransientOptions:
     rtol: float = 1e-6
     atol: float = 0.0
     max_steps: int = 5000
+    stall_steps: int = 200
     solver: str | None = None
 
     def __post_init__(self) -> None:
@@ -232,6 +236,12 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
             if t >= end and (relative <= opts.rtol or norm <= opts.atol):
                 result.converged, result.relative_residual = True, relative
                 break
+            held = [r for r, tl in zip(result.residuals, result.load_factors, strict=True) if tl >= end]
+            if opts.stall_steps and len(held) > opts.stall_steps and \
+                    min(held[-opts.stall_steps:]) > 0.5 * held[-opts.stall_steps - 1]:
+                raise _give_up(None, None, len(result.pseudo_times), t, result, dtau,
+                               reason=f"stalled: the residual at the held load fell by less than half in "
+                                      f"{opts.stall_steps} pseudo-steps (relative {relative:.2e})")
             if dtau < opts.min_step:
                 error_type = NonPositiveJacobianError if isinstance(failure, NonPositiveJacobianError) else None
                 raise _give_up(error_type, failure, len(result.pseudo_times) + 1, t, result, dtau)
