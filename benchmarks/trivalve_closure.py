@@ -76,6 +76,13 @@ PTC_FLAGS = {
 }
 
 
+def _add_flags(parser: argparse.ArgumentParser, table: dict, prefix: str, defaults: str) -> None:
+    """``--<prefix><name>`` for each entry of a flag table (default None: the options' own value)."""
+    for name, (kind, text) in table.items():
+        parser.add_argument("--" + prefix + name.replace("_", "-"), type=kind, default=None,
+                            help=f"{text} (default: {defaults})")
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("trivalve_closure_out"))
@@ -84,16 +91,12 @@ def main() -> int:
     parser.add_argument("--resume", action="store_true", help="start from --out/last_state.npz")
     parser.add_argument("--report", action="store_true",
                         help="with --resume: measure and draw the kept state (Table 2-3 rows, figures, VTU), no solve")
-    for name, (kind, text) in OPTION_FLAGS.items():
-        parser.add_argument("--" + name.replace("_", "-"), type=kind, default=None,
-                            help=f"{text} (default: ClosureOptions.for_model)")
+    _add_flags(parser, OPTION_FLAGS, "", "ClosureOptions.for_model")
     parser.add_argument("--hold-papillary", action="store_true",
                         help="a variant: papillary tips held where they are (no tethering), pressure stage only")
     parser.add_argument("--method", choices=("newton", "ptc"), default="ptc",
                         help="load-stepped Newton with damped steps, or pseudo-transient continuation (default)")
-    for name, (kind, text) in PTC_FLAGS.items():
-        parser.add_argument("--ptc-" + name.replace("_", "-"), type=kind, default=None,
-                            help=f"{text} (default: skvalve.valve.closure.relaxation_options)")
+    _add_flags(parser, PTC_FLAGS, "ptc-", "skvalve.valve.closure.relaxation_options")
     parser.add_argument("--input", type=Path, default=None,
                         help="another TriValve input (.inp; default: the 1.0 diseased valve, $SKVALVE_TRIVALVE)")
     args = parser.parse_args()

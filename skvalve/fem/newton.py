@@ -126,7 +126,9 @@ def _load_factors(steps, t0: float) -> np.ndarray:
     return factors[factors > t0 * (1 + 1e-12)]
 
 
-def _reference(problem: Problem, residual: np.ndarray, fixed: np.ndarray) -> float:
+def reference_force(problem: Problem, residual: np.ndarray, fixed: np.ndarray) -> float:
+    """The scale of a relative residual: the larger of the reactions' and the external forces' norms (after the
+    last :meth:`~skvalve.fem.problem.Problem.assemble`)."""
     return max(np.linalg.norm(residual[fixed]), np.linalg.norm(problem.external_forces), 1e-300)
 
 
@@ -167,7 +169,7 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
     if free.size == 0:  # every dof prescribed: the state is known, the residual gives the reactions
         residual, tangent = problem.assemble(u, t_new, tangent=True, step=step)
         return u, residual, [], tangent
-    reference = _reference(problem, residual, fixed)
+    reference = reference_force(problem, residual, fixed)
     norm = np.linalg.norm(rhs[free])
     history = []
     if not moved and norm <= max(opts.rtol * reference, opts.atol):
@@ -229,7 +231,7 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
         if opts.regularization > 0.0:  # Levenberg-Marquardt: relax after a full step, tighten after a short one
             shift = shift * 0.25 if alpha >= first_length else min(4.0 * max(shift, _SHIFT_FLOOR), _SHIFT_CEILING)
         rhs = residual
-        reference = _reference(problem, residual, fixed)
+        reference = reference_force(problem, residual, fixed)
         relative = norm / reference
         relative_energy = energy / energy0 if energy0 > 0 else 0.0
         record = {"step": step, "load_factor": t_new, "iteration": iteration, "residual": norm,

@@ -42,6 +42,7 @@ from tqdm.auto import tqdm
 
 from . import linsolve
 from .errors import ConvergenceError, NonPositiveJacobianError
+from .newton import reference_force
 from .problem import Problem
 
 __all__ = ["PseudoTransientOptions", "PseudoTransientStep", "PseudoTransientResult", "pseudo_transient"]
@@ -228,15 +229,16 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
     result.timings["assembly"] += time.perf_counter() - start
     norm = float(np.linalg.norm(residual[free]))
     tau, t, dtau = t0, t0, opts.first_step
+    held_from = 0 if t0 >= end else None  # index of the first accepted step at the held load
     failure: Exception | None = None
     bar = tqdm(total=None if end == t0 else 100, disable=not progress, desc="pseudo-time", leave=False)
     try:
         while len(result.pseudo_times) < opts.max_steps:
-            relative = norm / _reference(problem, residual, fixed)
+            relative = norm / reference_force(problem, residual, fixed)
             if t >= end and (relative <= opts.rtol or norm <= opts.atol):
                 result.converged, result.relative_residual = True, relative
                 break
-            held = [r for r, tl in zip(result.residuals, result.load_factors, strict=True) if tl >= end]
+            held = result.residuals[held_from:] if held_from is not None else []
             if opts.stall_steps and len(held) > opts.stall_steps and \
                     min(held[-opts.stall_steps:]) > 0.5 * held[-opts.stall_steps - 1]:
                 raise _give_up(None, None, len(result.pseudo_times), t, result, dtau,
@@ -279,7 +281,9 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
             u, residual, tangent = trial, trial_residual, trial_tangent
             norm = float(np.linalg.norm(residual[free]))
             tau, t = tau + dtau, t_new
-            relative = norm / _reference(problem, residual, fixed)
+            if held_from is None and t >= end:
+                held_from = len(result.residuals)
+            relative = norm / reference_force(problem, residual, fixed)
             result.u, result.load_factor, result.relative_residual = u, t, relative
             for name, value in (("pseudo_times", tau), ("load_factors", t), ("step_lengths", dtau),
                                 ("residuals", norm), ("largest_increments", largest)):
@@ -404,10 +408,6 @@ def _checked_edges(problem: Problem, edges, rest_lengths) -> tuple[np.ndarray, n
     if rest.shape != (pairs.shape[0],) or not np.all(np.isfinite(rest) & (rest > 0.0)):
         raise ValueError(f"edge rest lengths must be {pairs.shape[0]} positive finite lengths")
     return pairs, rest, X
-
-
-def _reference(problem: Problem, residual: np.ndarray, fixed: np.ndarray) -> float:
-    return max(float(np.linalg.norm(residual[fixed])), float(np.linalg.norm(problem.external_forces)), 1e-300)
 
 
 def _give_up(error_type, cause, step: int, t: float, result: PseudoTransientResult, dtau: float,

@@ -297,7 +297,7 @@ def relaxation_options(pressure_start: float = 0.5, **overrides) -> list[tuple[f
 
 class EveryLoadFactor:
     """A callback passed on only when the load factor enters a new multiple of ``spacing`` (pseudo-transient runs take
-    hundreds of steps; a VTU series wants tens), or when ``always(event)`` says so."""
+    hundreds of steps; a VTU series wants tens)."""
 
     def __init__(self, callback, spacing: float = 0.05) -> None:
         if not spacing > 0.0:
@@ -334,35 +334,36 @@ def relax_closure(setup: ClosureSetup, end: float,
         run.u = event.u
 
     edges, rest_lengths = watched_edges(setup.model) if setup.model is not None else (None, None)
+    weights = damping_weights(setup.problem.space)
     start = time.perf_counter()
     result = None
-    timings: dict[str, float] = {}
+
+    def add_effort(stage_result) -> None:
+        for key, value in (*stage_result.timings.items(), ("rejected_steps", float(stage_result.rejected))):
+            run.timings[key] = run.timings.get(key, 0.0) + value
+
     try:
         for until, stage in stages:
             stop = min(until, end)
             if stop <= t0 and until < end:
                 continue
-            result = pseudo_transient(setup.problem, damping_weights(setup.problem.space), stop, stage, u0=u0, t0=t0,
-                                      edges=edges, rest_lengths=rest_lengths, callbacks=[record, *callbacks],
-                                      progress=progress, verbose=verbose)
-            for key, value in (*result.timings.items(), ("rejected_steps", float(result.rejected))):
-                timings[key] = timings.get(key, 0.0) + value
+            result = pseudo_transient(setup.problem, weights, stop, stage, u0=u0, t0=t0, edges=edges,
+                                      rest_lengths=rest_lengths, callbacks=[record, *callbacks], progress=progress,
+                                      verbose=verbose)
+            add_effort(result)
             u0, t0 = result.u, result.load_factor
             if stop >= end:
                 break
     except Exception as err:  # noqa: BLE001 - a failed closure is a result to report, with its last state
         run.error = f"{type(err).__name__}: {err}"
         result = getattr(err, "last_state", None)
+        if result is not None:  # the failed stage's effort
+            add_effort(result)
     finally:
         run.peak_memory_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: kB
         run.seconds = time.perf_counter() - start
-    if result is not None:
-        if run.error is not None:  # the failed stage's effort
-            for key, value in (*result.timings.items(), ("rejected_steps", float(result.rejected))):
-                timings[key] = timings.get(key, 0.0) + value
-        elif result.converged is False:
-            run.error = "did not converge"
-    run.timings = timings
+    if result is not None and run.error is None and not result.converged:
+        run.error = "did not converge"
     if run.u is not None:
         run.undamped_residual = undamped_residual(setup.problem, run.u, run.load_factors[-1])
     return run
