@@ -50,6 +50,7 @@ OPTION_FLAGS = {
     "contact_exclude_within": (float, "node-face pairs closer than this (mm) in the reference never contact"),
     "contact_ramp": (float, "step-time interval over which the contact penalty rises smoothly to its value"),
     "penalty": (float, "contact penalty (MPa/mm)"),
+    "cable_compression": (int, "1: cables that are one input truss carry their law in compression too"),
 }
 
 
@@ -73,6 +74,7 @@ PTC_FLAGS = {
     "blow_up": (float, "reject a step whose residual grows more than this factor"),
     "local_damping": (float, "factor on the damping of nodes that break a trust region (1: off)"),
     "max_strain_increment": (float, "trust region: largest change of an edge's or cable's tensile stretch per step"),
+    "held_growth": (float, "smallest growth of the pseudo-time step per accepted step at the held load"),
 }
 
 

@@ -12,7 +12,7 @@ from scipy.optimize import brentq
 from skvalve.fem import NodalForce, Problem, Solid, solve
 from skvalve.fem.damping import lumped_volume
 from skvalve.fem.errors import ConvergenceError
-from skvalve.fem.ptc import PseudoTransientOptions, pseudo_transient
+from skvalve.fem.ptc import PseudoTransientOptions, _carriers, pseudo_transient
 from skvalve.fem.terms import Blocks, Contribution, Term
 from skvalve.fem.truss import Truss
 from skvalve.materials import NeoHookean
@@ -58,6 +58,40 @@ def test_relaxes_to_the_equilibrium_newton_reaches():
                               progress=False)
     assert damped.converged and np.abs(damped.u - newton.u()).max() <= 1e-9 * np.abs(newton.u()).max()
     assert damped.step_lengths != result.step_lengths
+
+
+def test_held_growth_lengthens_every_step_whose_residual_does_not_grow():
+    """``held_growth``: at the held load the pseudo-time step grows at least by that factor (at most by ``growth``)
+    after each accepted step whose residual fell, and the end state is still Newton's."""
+    newton = solve(_sheared_block(), 10, progress=False, rtol=1e-11)
+    block = _sheared_block()
+    options = PseudoTransientOptions(damping=1.0, first_step=0.05, max_load_step=0.1, rtol=1e-11, max_increment=None,
+                                     max_strain_increment=None, stiffness_damping=0.5, held_growth=1.5, growth=3.0)
+    result = pseudo_transient(block, lumped_volume(block.space), 1.0, options, progress=False)
+    assert result.converged and np.abs(result.u - newton.u()).max() <= 1e-9 * np.abs(newton.u()).max()
+    held = np.flatnonzero(np.array(result.load_factors) == 1.0)
+    ratios = [(result.step_lengths[k + 1] / result.step_lengths[k], result.residuals[k] / result.residuals[k - 1])
+              for k in held[1:-1]]
+    assert ratios and all(1.5 - 1e-12 <= ratio <= 3.0 + 1e-12 for ratio, fell in ratios if fell <= 1.0)
+    # with pure SER (held_growth 1) the same problem takes more held steps
+    block = _sheared_block()
+    plain = pseudo_transient(block, lumped_volume(block.space), 1.0, replace(options, held_growth=1.0), progress=False)
+    assert plain.converged and len(plain.pseudo_times) > len(result.pseudo_times)
+    with pytest.raises(ValueError, match="held_growth"):
+        PseudoTransientOptions(held_growth=3.0, growth=2.0)
+
+
+def test_the_carriers_of_a_blown_up_residual_are_the_fewest_nodes_with_most_of_it():
+    """``_carriers`` picks, by hand: nodal residual norms 3, 1, 10, 0.5 (squares 9, 1, 100, 0.25; sum 110.25): 90 %
+    (99.2) needs node 2 alone, 95 % (104.7) nodes 2 and 0; without node 2's dof (a reaction, not a residual) the
+    squares 9, 1, 0.25 need nodes 0 and 1 for 90 % (9.2)."""
+    space = type("Space", (), {"n_u": 12, "dim": 3})()
+    residual = np.zeros(12)
+    residual[[0, 4, 6, 9]] = [3.0, 1.0, 10.0, 0.5]  # nodes 0, 1, 2, 3
+    free = np.arange(12)
+    assert _carriers(residual, free, space).tolist() == [2]
+    assert _carriers(residual, free, space, share=0.95).tolist() == [2, 0]
+    assert _carriers(residual, np.setdiff1d(free, [6]), space).tolist() == [0, 1]
 
 
 def _slack_chord(force: float):

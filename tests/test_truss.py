@@ -128,6 +128,31 @@ def test_single_chord_against_closed_form():
     assert np.allclose(result.u()[3 * b + 1: 3 * b + 3], 0.0, atol=1e-12)
 
 
+
+def test_a_single_truss_with_the_plain_law_carries_compression_beside_a_slack_chain():
+    """Laws mixed in one term (``ValveModel.problem(compression=True)``): bar 0, a tension-only chain with slack
+    stretch 0.8, and bar 1, a single truss with the plain Ogden law (slack stretch 1), both shortened to 0.9 of their
+    rest length. The chain carries only its slack spring k_s (0.9 - 0.8); the truss carries A P(0.9) < 0 written out
+    from the Ogden formula. A plain law with a slack stretch below 1 is refused."""
+    space = _single_chord_space(2.0)
+    X = space.dof_coordinates
+    a = int(np.flatnonzero(np.all(np.isclose(X, 0.0), axis=0))[0])
+    b = int(np.flatnonzero(np.isclose(X[0], 2.0) & np.isclose(X[1], 0) & np.isclose(X[2], 0))[0])
+    cable = TensionOnly(CHORD, slack_fraction=1e-4)
+    truss = Truss(space, [[a, b], [a, b]], 0.3, [cable, CHORD], np.array([0, 1]), rest_length=[2.0, 2.0],
+                  slack_stretch=[0.8, 1.0])
+    u = np.zeros(space.n_dofs)
+    u[3 * b] = -0.2  # both bars at stretch 0.9
+    response = truss.response(u)
+    by_hand = sum(2 * m / al * (0.9 ** (al - 1) - 0.9 ** (-al / 2 - 1)) for m, al in zip(CHORD.mu, CHORD.alpha,
+                                                                                          strict=True))
+    assert by_hand < 0.0
+    assert response.axial_force[1] == pytest.approx(0.3 * by_hand, rel=1e-12)
+    assert response.axial_force[0] == pytest.approx(0.3 * cable.slack_stiffness * 0.1, rel=1e-12)
+    with pytest.raises(TypeError, match="slack stretch below 1 needs a tension-only law"):
+        Truss(space, [[a, b], [a, b]], 0.3, [cable, CHORD], np.array([0, 1]), slack_stretch=[1.0, 0.9])
+
+
 def test_chord_tied_to_a_block():
     """A chord pulls the free face of a block: chord force = block reaction, and the chord force equals
     A P(lambda) at the stretch the solve reached (two laws meeting at shared nodes)."""

@@ -107,6 +107,28 @@ def test_collapsed_chordae_have_no_zero_stiffness_direction(models, key):
     assert np.linalg.eigvalsh(K0)[0] <= 1e-12 * np.abs(K0).max()
 
 
+def test_compression_gives_the_single_trusses_their_plain_law(models):
+    """``problem(compression=True)``: the cables that are one input truss (slack stretch 1) carry the Ogden law of
+    their group at a shortening (as the input's T3D2 trusses with *Hyperelastic, OGDEN do), the collapsed chains only
+    their slack spring; without it every cable is slack when shortened."""
+    if "1.0-diseased" not in models:
+        pytest.skip("1.0 diseased not present")
+    _, model = models["1.0-diseased"]
+    ch = model.chordae
+    single = np.abs(ch.slack_stretch - 1.0) <= 1e-9
+    assert 0 < single.sum() < single.size
+    stretch = 0.9 * np.minimum(ch.slack_stretch, 1.0)  # every cable shortened below its force-free stretch
+    for compression in (True, False):
+        truss = next(t for t in model.problem(insertion="node", compression=compression).terms
+                     if type(t).__name__ == "Truss")
+        P, _ = truss.laws.evaluate(stretch, truss.slack_stretch)
+        law_P = np.array([ch.laws[k].nominal_stress(np.array([s]))[0][0] for k, s in zip(ch.law_index, stretch,
+                                                                                          strict=True)])
+        if compression:
+            assert np.allclose(P[single], law_P[single], rtol=1e-12)
+        assert np.all(np.abs(P[~single if compression else slice(None)]) < 1e-3 * np.abs(law_P).max())
+
+
 def test_diseased_pressure_and_conditions_follow_the_input(models):
     """Total follower-pressure force in the reference state = -p(t) x the vector area of the Abaqus faces (outward
     by the right-hand rule of the face definitions), with p(t) = 0.00567 MPa x SMOOTH STEP(0.5, 1.5); the papillary

@@ -69,6 +69,11 @@ class PseudoTransientOptions:
         The largest :math:`\Delta\tau` while the load factor still moves (the load path's resolution).
     growth : float
         The largest SER growth of :math:`\Delta\tau` per step once the load is held.
+    held_growth : float
+        The smallest growth of :math:`\Delta\tau` per accepted step once the load is held (1: pure SER). SER alone
+        keeps :math:`\Delta\tau` where a residual that does not fall (a slow, damped mode of a soft structure) leaves
+        it; a growth on every accepted step fades the damping anyway, the trust regions and local damping catching the
+        steps that then overshoot.
     load_growth : float
         The growth of :math:`\Delta\tau` per accepted step while the load moves (back towards ``max_load_step``
         after a cut; a gentle value wastes fewer rejected steps on a path whose trust regions bind).
@@ -87,11 +92,12 @@ class PseudoTransientOptions:
         inversion test still apply): a growth that no shorter step removes is a discontinuity of the problem (a
         contact pair that enters at a finite overlap), not an overshoot, and the steps after it resolve it.
     local_damping, max_local_damping, local_decay : float
-        When nodes break a trust region, their damping weights are multiplied by ``local_damping`` (at most
-        ``max_local_damping`` times their start value) and the step is retried only a little shorter, instead of
-        cutting the pseudo-time step for the whole problem by the factor the worst node needs (the implicit analogue
-        of an explicit code's selective mass scaling; the equilibrium does not depend on the weights); after each
-        accepted step the raised weights fall by ``local_decay`` towards their start values. 1: off.
+        When nodes break a trust region, or carry most of a residual that grew past ``blow_up``, their whole damping
+        (mass and stiffness-proportional parts) is multiplied by ``local_damping`` (at most ``max_local_damping``
+        times in all) and the step is retried only a little shorter, instead of cutting the pseudo-time step for the
+        whole problem by the factor the worst node needs (a local pseudo-time step, the implicit analogue of an
+        explicit code's selective mass scaling; the equilibrium does not depend on the damping); after each accepted
+        step the factors fall by ``local_decay`` towards 1. 1: off.
     rtol, atol : float
         Converged, once the load is at ``end``, when the free residual is at most the larger of ``atol`` and
         ``rtol`` times the larger of the reactions' and the external forces' norms.
@@ -110,6 +116,7 @@ class PseudoTransientOptions:
     min_step: float = 1e-9
     max_load_step: float = 0.01
     growth: float = 2.0
+    held_growth: float = 1.0
     load_growth: float = 1.25
     max_increment: float | None = 0.5
     max_strain_increment: float | None = 0.05
@@ -125,7 +132,8 @@ class PseudoTransientOptions:
     solver: str | None = None
 
     def __post_init__(self) -> None:
-        positive = ("damping", "first_step", "min_step", "max_load_step", "growth", "load_growth", "blow_up", "rtol",
+        positive = ("damping", "first_step", "min_step", "max_load_step", "growth", "held_growth", "load_growth",
+                    "blow_up", "rtol",
                     "local_damping", "max_local_damping")
         if not (math.isfinite(self.accept_jumps_below) and self.accept_jumps_below >= 0):
             raise ValueError("PseudoTransientOptions.accept_jumps_below must be finite and >= 0; "
@@ -149,9 +157,10 @@ class PseudoTransientOptions:
             raise ValueError(f"PseudoTransientOptions.atol must be finite and >= 0; got {self.atol!r}")
         if not 0.0 < self.local_decay <= 1.0:
             raise ValueError(f"PseudoTransientOptions.local_decay must lie in (0, 1]; got {self.local_decay!r}")
-        if self.growth < 1.0 or self.load_growth < 1.0:
-            raise ValueError(f"PseudoTransientOptions.growth and load_growth must be >= 1; got {self.growth!r}, "
-                             f"{self.load_growth!r}")
+        if min(self.growth, self.load_growth, self.held_growth) < 1.0 or self.held_growth > self.growth:
+            raise ValueError("PseudoTransientOptions: need 1 <= held_growth <= growth and load_growth >= 1; got "
+                             f"growth={self.growth!r}, held_growth={self.held_growth!r}, "
+                             f"load_growth={self.load_growth!r}")
 
 
 @dataclass
@@ -206,17 +215,18 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
     opts = options or PseudoTransientOptions()
     solver = linsolve.solver_name(opts.solver)
     n = problem.space.n_dofs
-    weights = np.array(weights, dtype=float).ravel()  # a copy: local damping raises entries of it
+    weights = np.array(weights, dtype=float).ravel()
     if weights.shape != (n,) or not np.all(np.isfinite(weights) & (weights >= 0.0)):
         raise ValueError(f"weights must be {n} finite values >= 0")
     if not (math.isfinite(end) and end >= t0 >= 0.0):
         raise ValueError(f"need 0 <= t0 <= end; got t0={t0!r}, end={end!r}")
     if edges is not None:
         edges = _checked_edges(problem, edges, rest_lengths)
-    original, base = weights.copy(), weights.copy()
-    positive = base[base > 0.0]
-    if positive.size:  # local damping needs a base weight on every displacement dof
-        base[: problem.space.n_u] = np.maximum(base[: problem.space.n_u], float(np.median(positive)) * 1e-3)
+    floor = weights.copy()
+    positive = floor[floor > 0.0]
+    if positive.size:  # local damping needs a weight on every displacement dof to multiply
+        floor[: problem.space.n_u] = np.maximum(floor[: problem.space.n_u], float(np.median(positive)) * 1e-3)
+    boost = np.ones(n)  # local damping factors (1: none)
     problem.check_supports()
     pattern = problem.pattern
     fixed, free = pattern.fixed, pattern.free
@@ -254,9 +264,10 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
                 t_new = end
             step = len(result.pseudo_times) + 1
             try:
-                trial, trial_residual, trial_tangent, largest = _step(problem, u, t, t_new, dtau, tangent, weights,
-                                                                       norm, opts, solver, step, result.timings,
-                                                                       edges)
+                local = np.where(boost > 1.0, floor, weights)
+                trial, trial_residual, trial_tangent, largest = _step(problem, u, t, t_new, dtau, tangent, local,
+                                                                       boost, norm, opts, solver, step,
+                                                                       result.timings, edges)
             except _Rejected as err:
                 problem.rewind()
                 result.rejected += 1
@@ -266,8 +277,7 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
                 if opts.local_damping > 1.0 and nodes is not None and nodes.size:
                     # damp the nodes that broke a trust region, not the whole problem (cf. selective mass scaling)
                     dofs = problem.space.displacement_dofs(nodes).ravel()
-                    weights[dofs] = np.minimum(np.maximum(weights[dofs], base[dofs]) * opts.local_damping,
-                                               base[dofs] * opts.max_local_damping)
+                    boost[dofs] = np.minimum(boost[dofs] * opts.local_damping, opts.max_local_damping)
                     factor = max(factor, 0.7)
                 logger.info("pseudo-step %d (t=%.5g, dtau=%.3g) rejected: %s", step, t_new, dtau, err)
                 if verbose:
@@ -276,7 +286,7 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
                 continue
             problem.commit()
             if opts.local_damping > 1.0:  # boosts fade: a node damped for one hard step must not stay frozen
-                np.maximum(original, weights * opts.local_decay, out=weights)
+                np.maximum(1.0, boost * opts.local_decay, out=boost)
             previous = norm
             u, residual, tangent = trial, trial_residual, trial_tangent
             norm = float(np.linalg.norm(residual[free]))
@@ -301,7 +311,8 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
             if t < end:  # following the load: grow back towards the load path's resolution after cuts
                 dtau = min(dtau * opts.load_growth, opts.max_load_step)
             else:  # switched evolution relaxation
-                dtau *= min(opts.growth, max(previous / max(norm, 1e-300), 0.5))
+                dtau *= min(opts.growth, max(previous / max(norm, 1e-300), opts.held_growth if norm <= previous
+                                             else 0.5))
             failure = None
         else:
             raise _give_up(None, None, len(result.pseudo_times), t, result, dtau,
@@ -311,9 +322,10 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
     return result
 
 
-def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent, weights, norm: float,
+def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent, weights, boost, norm: float,
           opts: PseudoTransientOptions, solver: str, step: int, timings: dict, edges: tuple | None):
-    """One linearised implicit-Euler step; raises :class:`_Rejected` (with a cut ``factor``) when it fails a test."""
+    """One linearised implicit-Euler step with the damping diagonal ``boost * (c weights + beta |diag K|)``;
+    raises :class:`_Rejected` (with a cut ``factor`` and the ``nodes`` to damp) when it fails a test."""
     pattern = problem.pattern
     fixed, free = pattern.fixed, pattern.free
     clock = time.perf_counter()
@@ -334,7 +346,7 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
         raise ValueError(f"stiffness_damping must be finite and >= 0; got {beta!r} at load factor {t_new}")
     if beta > 0.0:
         diagonal = diagonal + beta * np.abs(K.diagonal())
-    K = K + sp.diags(diagonal / dtau, format="csr")
+    K = K + sp.diags(boost[free] * diagonal / dtau, format="csr")
     timings["assembly"] += time.perf_counter() - clock
     clock = time.perf_counter()
     try:
@@ -379,8 +391,21 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
     if not np.isfinite(trial_norm):
         raise _Rejected("the residual is not finite")
     if trial_norm > opts.blow_up * reference and dtau >= opts.accept_jumps_below:
-        raise _Rejected(f"|R| grows from {reference:.3e} to {trial_norm:.3e}")
+        rejected = _Rejected(f"|R| grows from {reference:.3e} to {trial_norm:.3e}")
+        rejected.nodes = _carriers(trial_residual, free, space)
+        raise rejected
     return trial, trial_residual, trial_tangent, largest
+
+
+def _carriers(residual: np.ndarray, free: np.ndarray, space, share: float = 0.9, most: int = 1000) -> np.ndarray:
+    """The fewest nodes (at most ``most``) that carry ``share`` of the squared free residual: where a step that
+    blew up went wrong."""
+    masked = np.zeros_like(residual)
+    masked[free] = residual[free]
+    nodal = (masked[: space.n_u].reshape(-1, space.dim) ** 2).sum(axis=1)
+    order = np.argsort(nodal)[::-1][:most]
+    count = int(np.searchsorted(np.cumsum(nodal[order]), share * nodal.sum())) + 1
+    return order[: min(count, order.size)]
 
 
 def _stretch_changes(X: np.ndarray, u: np.ndarray, trial: np.ndarray, edges: np.ndarray,

@@ -198,9 +198,11 @@ class Truss(Term):
             self.slack_stretch = np.broadcast_to(np.asarray(slack_stretch, dtype=float), (self.n_bars,)).copy()
             if np.any(~(self.slack_stretch > 0.0) | (self.slack_stretch > 1.0)):
                 raise ValueError(f"{name}: slack_stretch must lie in (0, 1]")
-            for law in self.laws.laws:
-                if not isinstance(law, TensionOnly):
-                    raise TypeError(f"{name}: slack_stretch needs tension-only laws; got {type(law).__name__}")
+            for k, law in enumerate(self.laws.laws):
+                slack = self.slack_stretch[self.laws.index == k]
+                if not isinstance(law, TensionOnly) and np.any(np.abs(slack - 1.0) > 1e-9):
+                    raise TypeError(f"{name}: a slack stretch below 1 needs a tension-only law; bars of law {k} "
+                                    f"({type(law).__name__}) have {slack.min():.6g}")
 
     def connectivity(self) -> list[np.ndarray]:
         return [self.dofs]

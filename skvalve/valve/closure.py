@@ -68,6 +68,8 @@ class ClosureOptions:
     drags them there, so they take far more damping than the papillary stage does.
     cable_slack_fraction : the cables' stiffness below their slack length, relative to their small-strain modulus
     (:meth:`~skvalve.valve.model.ValveModel.problem`; Abaqus's T3D2 chordae resist compression with their full law).
+    cable_compression : the cables that are one input truss carry their law in compression as well, as the input's
+    trusses do (``ValveModel.problem(compression=True)``); collapsed chains stay tension-only.
     contact_exclude_within : node-face pairs whose reference distance is below this never contact
     (:class:`~skvalve.fem.contact.SurfaceContact` ``exclude_within``; on the 1.0 valve the only pairs of the papillary
     stage were rim nodes against the inner face of their own leaflet 0.5 mm away, across the 0.78 mm thick corner).
@@ -114,6 +116,7 @@ class ClosureOptions:
     contact_ramp: float = 0.0
     contact_exclude_within: float = 0.0
     cable_slack_fraction: float = 1e-6
+    cable_compression: bool = False
     pressure_damping: float = 1e-4
 
     @classmethod
@@ -193,7 +196,8 @@ def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: Abaq
                                     "folder (model files of Mathur et al. 2022, CC BY-NC-SA 4.0)")
         abaqus = read_model(path)
     model = valve_model(abaqus) if model is None else model
-    problem = model.problem(insertion=options.insertion, slack_fraction=options.cable_slack_fraction)
+    problem = model.problem(insertion=options.insertion, slack_fraction=options.cable_slack_fraction,
+                            compression=options.cable_compression)
     if options.cable_softening != 1.0:
         ramp = GeometricRamp(options.cable_softening, *options.cable_stiffening)
         for term in problem.terms:

@@ -175,7 +175,7 @@ class ValveModel:
                           self.links.subset(new) if self.links is not None else None)
 
     def problem(self, solid: str = "fbar", slack_fraction: float = 1e-6, transition: float = 0.01,
-                insertion: str = "node") -> Problem:
+                insertion: str = "node", compression: bool = False) -> Problem:
         """A :class:`~skvalve.fem.Problem` of the model (load factor = step time).
 
         ``solid``: ``"fbar"`` (F-bar mean-dilatation hexes, default) or ``"q1"`` (full integration, locks).
@@ -186,6 +186,9 @@ class ValveModel:
         ``transition``: stretch interval over which a cable's slope ramps from slack to taut (C1, for Newton).
         ``insertion``: ``"node"`` (the input's point attachment) or ``"patch"`` (each cable end on the leaflet
         spread over the vertices of the cells around it: :func:`~skvalve.valve.chordae.insertion_patches`).
+        ``compression``: cables that are one input truss (force-free length = reference length) carry their law in
+        compression too, as the input's truss elements with a hyperelastic law do (it has no ``*No Compression``);
+        collapsed chains stay tension-only (a chain of pin-jointed trusses buckles at its hinges).
         """
         space = Space(self.mesh)
         materials = MaterialRegions(self.mesh, list(self.laws), self.regions)
@@ -198,13 +201,18 @@ class ValveModel:
         problem = Problem(space, [leaflets])
         ch = self.chordae
         cables = [TensionOnly(law, slack_fraction, transition) for law in ch.laws]
+        law_index = ch.law_index
+        if compression:  # laws k + n: the plain law, both ways, for the single trusses
+            single = np.isclose(ch.slack_stretch, 1.0, rtol=0.0, atol=1e-9)
+            law_index = np.where(single, ch.law_index + len(ch.laws), ch.law_index)
+            cables = cables + list(ch.laws)
         if insertion not in ("node", "patch"):
             raise ValueError(f"insertion must be 'node' or 'patch'; got {insertion!r}")
         if ch.ends.shape[0]:
             ends, rest, slack = ch.ends, ch.rest_length, ch.slack_stretch
             if insertion == "patch":
                 ends, rest, slack = insertion_patches(self.mesh.t, self.mesh.p, ch.ends, ch.rest_length)
-            problem.add_term(Truss(space, ends, ch.area, cables, ch.law_index, rest, slack, name="chordae"))
+            problem.add_term(Truss(space, ends, ch.area, cables, law_index, rest, slack, name="chordae"))
         if self.links is not None and self.links.size:
             problem.add_term(self.links.term(space))
         for load in self.pressures:
