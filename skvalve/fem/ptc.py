@@ -194,7 +194,11 @@ class PseudoTransientResult:
 
 
 class _Rejected(Exception):
-    pass
+    """A pseudo-step that failed a test: the factor to cut the step by, and the nodes to damp locally (if any)."""
+
+    def __init__(self, message: str, factor: float = 0.25, nodes: np.ndarray | None = None) -> None:
+        super().__init__(message)
+        self.factor, self.nodes = factor, nodes
 
 
 def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options: PseudoTransientOptions | None = None,
@@ -240,11 +244,11 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
     norm = float(np.linalg.norm(residual[free]))
     tau, t, dtau = t0, t0, opts.first_step
     held_from = 0 if t0 >= end else None  # index of the first accepted step at the held load
+    relative = norm / reference_force(problem, residual, fixed)
     failure: Exception | None = None
     bar = tqdm(total=None if end == t0 else 100, disable=not progress, desc="pseudo-time", leave=False)
     try:
         while len(result.pseudo_times) < opts.max_steps:
-            relative = norm / reference_force(problem, residual, fixed)
             if t >= end and (relative <= opts.rtol or norm <= opts.atol):
                 result.converged, result.relative_residual = True, relative
                 break
@@ -272,11 +276,10 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
                 problem.rewind()
                 result.rejected += 1
                 failure = err.__cause__ if err.__cause__ is not None else err
-                factor = getattr(err, "factor", 0.25)
-                nodes = getattr(err, "nodes", None)
-                if opts.local_damping > 1.0 and nodes is not None and nodes.size:
+                factor = err.factor
+                if opts.local_damping > 1.0 and err.nodes is not None and err.nodes.size:
                     # damp the nodes that broke a trust region, not the whole problem (cf. selective mass scaling)
-                    dofs = problem.space.displacement_dofs(nodes).ravel()
+                    dofs = problem.space.displacement_dofs(err.nodes).ravel()
                     boost[dofs] = np.minimum(boost[dofs] * opts.local_damping, opts.max_local_damping)
                     factor = max(factor, 0.7)
                 logger.info("pseudo-step %d (t=%.5g, dtau=%.3g) rejected: %s", step, t_new, dtau, err)
@@ -363,10 +366,8 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
     moves = np.linalg.norm(du[: space.n_u].reshape(-1, space.dim), axis=1)
     largest = float(np.max(moves, initial=0.0))
     if opts.max_increment is not None and largest > opts.max_increment:
-        rejected = _Rejected(f"a node would move {largest:.3g} > max_increment {opts.max_increment:g}")
-        rejected.factor = max(0.1, 0.7 * opts.max_increment / largest)
-        rejected.nodes = np.flatnonzero(moves > opts.max_increment)
-        raise rejected
+        raise _Rejected(f"a node would move {largest:.3g} > max_increment {opts.max_increment:g}",
+                        max(0.1, 0.7 * opts.max_increment / largest), np.flatnonzero(moves > opts.max_increment))
     trial[free] += du_free
     if edges is not None and opts.max_strain_increment is not None and edges[0].size:
         changes = _stretch_changes(edges[2], u, trial, edges[0], edges[1])
@@ -374,11 +375,9 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
         change = float(changes[worst])
         if change > opts.max_strain_increment:
             a, b = edges[0][worst]
-            rejected = _Rejected(f"the stretch of edge {a}-{b} would change by {change:.3g} > max_strain_increment "
-                                 f"{opts.max_strain_increment:g}")
-            rejected.factor = max(0.1, 0.7 * opts.max_strain_increment / change)
-            rejected.nodes = np.unique(edges[0][changes > opts.max_strain_increment])
-            raise rejected
+            raise _Rejected(f"the stretch of edge {a}-{b} would change by {change:.3g} > max_strain_increment "
+                            f"{opts.max_strain_increment:g}", max(0.1, 0.7 * opts.max_strain_increment / change),
+                            np.unique(edges[0][changes > opts.max_strain_increment]))
     clock = time.perf_counter()
     try:
         trial_residual, trial_tangent = problem.assemble(trial, t_new, tangent=True, step=step)
@@ -391,9 +390,8 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
     if not np.isfinite(trial_norm):
         raise _Rejected("the residual is not finite")
     if trial_norm > opts.blow_up * reference and dtau >= opts.accept_jumps_below:
-        rejected = _Rejected(f"|R| grows from {reference:.3e} to {trial_norm:.3e}")
-        rejected.nodes = _carriers(trial_residual, free, space)
-        raise rejected
+        carriers = _carriers(trial_residual, free, space)
+        raise _Rejected(f"|R| grows from {reference:.3e} to {trial_norm:.3e}", nodes=carriers)
     return trial, trial_residual, trial_tangent, largest
 
 
