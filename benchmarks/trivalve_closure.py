@@ -4,7 +4,8 @@ Runs :func:`skvalve.valve.closure.run_closure` from the open configuration to en
 with leaflet self-contact and the vanishing pseudo-transient damping, and prints wall time, load steps,
 Newton iterations, active contact pairs, peak memory, the undamped residual at the last converged state,
 and where it stopped if it did not reach the end. The last converged displacement is kept in
-``--out`` (``last_state.npz``, written atomically after every step; ``--resume`` restarts from it).
+``--out`` (``last_state.npz``, written atomically after every step and, at the end, replaced by the run's kept
+state: the held state with the smallest residual when the relaxation gave up; ``--resume`` restarts from it).
 Target: <= 1800 s on 2 cores. Needs the shipped inputs (``$SKVALVE_TRIVALVE``); exits 2 without them.
 
 Last line: ``trivalve_closure_seconds=<x>``.
@@ -71,6 +72,7 @@ PTC_FLAGS = {
     "first_step": (float, "first pseudo-time step"),
     "max_steps": (int, "the most accepted pseudo-steps"),
     "stiffness_damping": (float, "stiffness-proportional damping beta |diag K| / dtau"),
+    "held_stiffness_damping": (float, "stiffness-proportional damping once the load is held"),
     "blow_up": (float, "reject a step whose residual grows more than this factor"),
     "local_damping": (float, "factor on the damping of nodes that break a trust region (1: off)"),
     "max_strain_increment": (float, "trust region: largest change of an edge's or cable's tensile stretch per step"),
@@ -157,6 +159,9 @@ def main() -> int:
     else:
         run = run_closure(setup, options, callbacks=[LastState(args.out)], progress=False, verbose=args.verbose,
                           u0=u0, t0=t0)
+    if run.u is not None and not args.report:  # the kept state: the best held one when the relaxation gave up
+        replace_atomically(args.out / "last_state.npz",
+                           lambda temporary: np.savez(temporary, t=run.load_factors[-1], u=run.u))
     write_log(run, args.out / ("report_log.txt" if args.report else "closure_log.txt"))
     print(f"wall time {run.seconds:.1f} s, load steps {len(run.load_factors) - 1}, "
           f"Newton iterations {sum(run.iterations)}, contact pairs at the end "

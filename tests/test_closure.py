@@ -105,12 +105,13 @@ def test_contact_pairs_closer_than_exclude_within_in_the_reference_are_never_act
 
 def test_relaxation_controls_and_sampled_output():
     """The valve's pseudo-transient stages: the papillary stage with a tight stretch trust region and nothing else,
-    the pressure stage with stiffness-proportional and local damping and the overrides. The output sampler passes one
-    event per 0.05 of load factor, whatever the step count."""
+    the pressure stage with stiffness-proportional (none once held) and local damping and the overrides. The output
+    sampler passes one event per 0.05 of load factor, whatever the step count."""
     (until, first), (last_until, last) = relaxation_options(0.5, rtol=1e-7)
     assert until == 0.5 and first.max_strain_increment == 0.05 and first.stiffness_damping == 0.0
     assert first.local_damping == 1.0 and first.rtol == 1e-3
     assert last_until == np.inf and last.rtol == 1e-7 and last.stiffness_damping == 1e-3 and last.local_damping == 10
+    assert last.held_stiffness_damping == 0.0  # none once the pressure is held
     assert len(relaxation_options(0.0)) == 1  # everything ramps together: one stage
     seen = []
     sampler = EveryLoadFactor(lambda event: seen.append(event.load_factor), 0.05)

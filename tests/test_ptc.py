@@ -81,6 +81,59 @@ def test_held_growth_lengthens_every_step_whose_residual_does_not_grow():
         PseudoTransientOptions(held_growth=3.0, growth=2.0)
 
 
+def test_held_stiffness_damping_replaces_the_stiffness_damping_once_the_load_is_held():
+    """``held_stiffness_damping = 0``: the stiffness-proportional damping of the load path stops at the held load; the
+    end state is still Newton's, reached in fewer held steps than with the damping kept."""
+    newton = solve(_sheared_block(), 10, progress=False, rtol=1e-11)
+    options = PseudoTransientOptions(damping=1.0, first_step=0.05, max_load_step=0.1, rtol=1e-11, max_increment=None,
+                                     max_strain_increment=None, stiffness_damping=2.0)
+    results = []
+    for held in (None, 0.0):
+        block = _sheared_block()
+        results.append(pseudo_transient(block, lumped_volume(block.space), 1.0,
+                                        replace(options, held_stiffness_damping=held), progress=False))
+    kept, dropped = results
+    for result in results:
+        assert result.converged and np.abs(result.u - newton.u()).max() <= 1e-9 * np.abs(newton.u()).max()
+    # the load path is the same (same damping while the load moves), the held relaxation shorter
+    path = [k for k, t in enumerate(kept.load_factors) if t < 1.0]
+    assert [dropped.load_factors[k] for k in path] == [kept.load_factors[k] for k in path]
+    assert kept.load_factors.count(1.0) > dropped.load_factors.count(1.0)
+    with pytest.raises(ValueError, match="held_stiffness_damping"):
+        PseudoTransientOptions(held_stiffness_damping=-1.0)
+
+
+def test_giving_up_at_the_held_load_keeps_the_held_state_with_the_smallest_residual():
+    """A linear chord (k = 1) pulled by 0.4 and pushed back by 0.3 once past u = 0.2: no equilibrium (0.4 below
+    0.2, 0.1 above), so the held residual rises and falls around the jump. When the run gives up, its state is the
+    held one whose residual was smallest (found here from the callbacks), not the last."""
+    from skvalve.materials.uniaxial import LinearUniaxial
+
+    space, a, b = two_nodes()
+    chord = Truss(space, [[a, b]], 0.5, LinearUniaxial(4.0))
+    problem = Problem(space, [chord, NodalForce(space, np.array([b]), [0.4, 0.0, 0.0], ramp=True),
+                              _JumpForce(space.n_dofs, 3 * b, 0.2, -0.3)])
+    problem.add_dirichlet(nodes=np.setdiff1d(np.arange(space.n_scalar), [b]), value=0.0)
+    problem.add_dirichlet(nodes=[b], value=0.0, components=[1, 2])
+    weights = np.zeros(space.n_dofs)
+    weights[3 * b] = 1.0
+    seen = []
+    options = PseudoTransientOptions(damping=1.0, first_step=0.5, max_load_step=0.5, max_increment=None,
+                                     blow_up=1e6, max_steps=40, stall_steps=0)
+    with pytest.raises(ConvergenceError, match="40 pseudo-steps") as info:
+        pseudo_transient(problem, weights, 1.0, options, progress=False,
+                         callbacks=[lambda event: seen.append((event.step, event.load_factor, event.residual_norm,
+                                                               event.u.copy()))])
+    held = [event for event in seen if event[1] == 1.0]
+    best = min(held, key=lambda event: event[2])
+    kept = info.value.last_state
+    assert held[-1][2] > 1.5 * best[2]  # the last held state is not the best one: the test can tell them apart
+    assert kept.kept_step == best[0] and kept.load_factor == 1.0
+    assert np.array_equal(kept.u, best[3])
+    # the jump is where the residual is smallest: the kept state sits next to it
+    assert abs(kept.u[3 * b] - 0.2) < 0.1
+
+
 def test_the_carriers_of_a_blown_up_residual_are_the_fewest_nodes_with_most_of_it():
     """``_carriers`` picks, by hand: nodal residual norms 3, 1, 10, 0.5 (squares 9, 1, 100, 0.25; sum 110.25): 90 %
     (99.2) needs node 2 alone, 95 % (104.7) nodes 2 and 0; without node 2's dof (a reaction, not a residual) the
@@ -192,7 +245,7 @@ def test_a_residual_jump_no_shorter_step_removes_is_crossed():
             min_step=1e-7, blow_up=2.0), progress=False)
 
 
-def test_a_stalled_relaxation_gives_up_with_its_last_state():
+def test_a_stalled_relaxation_gives_up_with_a_held_state():
     """A pseudo-step so short that the held residual cannot halve in 5 steps: the run stops, naming the stall."""
     problem, _, b = _slack_chord(2.0)
     weights = np.zeros(problem.space.n_dofs)

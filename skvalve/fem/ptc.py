@@ -44,123 +44,11 @@ from . import linsolve
 from .errors import ConvergenceError, NonPositiveJacobianError
 from .newton import reference_force
 from .problem import Problem
+from .ptc_options import PseudoTransientOptions
 
 __all__ = ["PseudoTransientOptions", "PseudoTransientStep", "PseudoTransientResult", "pseudo_transient"]
 
 logger = logging.getLogger("skvalve.fem")
-
-
-@dataclass
-class PseudoTransientOptions:
-    r"""Controls of :func:`pseudo_transient` (units of the problem).
-
-    Attributes
-    ----------
-    damping : float
-        :math:`c`, the coefficient of :math:`M/\Delta\tau` (force per volume per length per unit pseudo-time).
-    stiffness_damping : float or callable
-        :math:`\beta`, a damping :math:`\beta\,|\mathrm{diag}\,K_{ff}|/\Delta\tau` proportional to the tangent's
-        diagonal (Rayleigh's stiffness-proportional part): it damps most where the material is stiffest, which is where
-        an element driven far into an exponential law loses stability. Zero: off; a callable: a function of the load
-        factor.
-    first_step, min_step : float
-        The first :math:`\Delta\tau`, and the smallest before giving up.
-    max_load_step : float
-        The largest :math:`\Delta\tau` while the load factor still moves (the load path's resolution).
-    growth : float
-        The largest SER growth of :math:`\Delta\tau` per step once the load is held.
-    held_growth : float
-        The smallest growth of :math:`\Delta\tau` per accepted step once the load is held (1: pure SER). SER alone
-        keeps :math:`\Delta\tau` where a residual that does not fall (a slow, damped mode of a soft structure) leaves
-        it; a growth on every accepted step fades the damping anyway, the trust regions and local damping catching the
-        steps that then overshoot.
-    load_growth : float
-        The growth of :math:`\Delta\tau` per accepted step while the load moves (back towards ``max_load_step``
-        after a cut; a gentle value wastes fewer rejected steps on a path whose trust regions bind).
-    max_increment : float or None
-        Trust region: the largest nodal displacement change in one step (length); ``None``: off.
-    max_strain_increment : float or None
-        Trust region on the ``edges`` given to :func:`pseudo_transient`: the largest change of an edge's tensile
-        stretch :math:`\max(\ell/L, 1)` in one step (``None``: off; slack cables and shortening edges move freely).
-        Exponential laws (collagenous leaflets, chordae) need it: a linearised step taken from the flat toe of such a
-        law into its steep part overshoots by orders of magnitude, however small the nodal displacement.
-    blow_up : float
-        Reject a step whose residual exceeds this multiple of the reference (the larger of the residual before the
-        step and the linearised one with the new prescribed values).
-    accept_jumps_below : float
-        A step shorter than this is accepted even when its residual grows past ``blow_up`` (the trust regions and the
-        inversion test still apply): a growth that no shorter step removes is a discontinuity of the problem (a
-        contact pair that enters at a finite overlap), not an overshoot, and the steps after it resolve it.
-    local_damping, max_local_damping, local_decay : float
-        When nodes break a trust region, or carry most of a residual that grew past ``blow_up``, their whole damping
-        (mass and stiffness-proportional parts) is multiplied by ``local_damping`` (at most ``max_local_damping``
-        times in all) and the step is retried only a little shorter, instead of cutting the pseudo-time step for the
-        whole problem by the factor the worst node needs (a local pseudo-time step, the implicit analogue of an
-        explicit code's selective mass scaling; the equilibrium does not depend on the damping); after each accepted
-        step the factors fall by ``local_decay`` towards 1. 1: off.
-    rtol, atol : float
-        Converged, once the load is at ``end``, when the free residual is at most the larger of ``atol`` and
-        ``rtol`` times the larger of the reactions' and the external forces' norms.
-    max_steps : int
-        The most accepted pseudo-steps.
-    stall_steps : int
-        Give up (``ConvergenceError``, last state kept) when, with the load held at ``end``, the residual has not
-        fallen below half its value of ``stall_steps`` steps before (0: never).
-    solver : str or None
-        Sparse backend (:func:`skvalve.fem.linsolve.solver_name`).
-    """
-
-    damping: float = 1e-4
-    stiffness_damping: float | Callable[[float], float] = 0.0
-    first_step: float = 1e-3
-    min_step: float = 1e-9
-    max_load_step: float = 0.01
-    growth: float = 2.0
-    held_growth: float = 1.0
-    load_growth: float = 1.25
-    max_increment: float | None = 0.5
-    max_strain_increment: float | None = 0.05
-    blow_up: float = 10.0
-    accept_jumps_below: float = 1e-6
-    local_damping: float = 1.0
-    max_local_damping: float = 1e4
-    local_decay: float = 0.5
-    rtol: float = 1e-6
-    atol: float = 0.0
-    max_steps: int = 5000
-    stall_steps: int = 200
-    solver: str | None = None
-
-    def __post_init__(self) -> None:
-        positive = ("damping", "first_step", "min_step", "max_load_step", "growth", "held_growth", "load_growth",
-                    "blow_up", "rtol",
-                    "local_damping", "max_local_damping")
-        if not (math.isfinite(self.accept_jumps_below) and self.accept_jumps_below >= 0):
-            raise ValueError("PseudoTransientOptions.accept_jumps_below must be finite and >= 0; "
-                             f"got {self.accept_jumps_below!r}")
-        for name in positive:
-            value = getattr(self, name)
-            if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
-                raise ValueError(f"PseudoTransientOptions.{name} must be a positive finite number; got {value!r}")
-        if self.max_increment is not None and not (math.isfinite(self.max_increment) and self.max_increment > 0):
-            raise ValueError("PseudoTransientOptions.max_increment must be None or positive; "
-                             f"got {self.max_increment!r}")
-        if self.max_strain_increment is not None and not (math.isfinite(self.max_strain_increment)
-                                                          and self.max_strain_increment > 0):
-            raise ValueError("PseudoTransientOptions.max_strain_increment must be None or positive; "
-                             f"got {self.max_strain_increment!r}")
-        if not callable(self.stiffness_damping) and not (math.isfinite(self.stiffness_damping)
-                                                         and self.stiffness_damping >= 0):
-            raise ValueError("PseudoTransientOptions.stiffness_damping must be finite and >= 0; "
-                             f"got {self.stiffness_damping!r}")
-        if not (math.isfinite(self.atol) and self.atol >= 0):
-            raise ValueError(f"PseudoTransientOptions.atol must be finite and >= 0; got {self.atol!r}")
-        if not 0.0 < self.local_decay <= 1.0:
-            raise ValueError(f"PseudoTransientOptions.local_decay must lie in (0, 1]; got {self.local_decay!r}")
-        if min(self.growth, self.load_growth, self.held_growth) < 1.0 or self.held_growth > self.growth:
-            raise ValueError("PseudoTransientOptions: need 1 <= held_growth <= growth and load_growth >= 1; got "
-                             f"growth={self.growth!r}, held_growth={self.held_growth!r}, "
-                             f"load_growth={self.load_growth!r}")
 
 
 @dataclass
@@ -178,7 +66,10 @@ class PseudoTransientStep:
 
 @dataclass
 class PseudoTransientResult:
-    """Accepted steps (pseudo-time, load factor, step length, residual, largest nodal change), the last state."""
+    """Accepted steps (pseudo-time, load factor, step length, residual, largest nodal change) and a state: the last
+    accepted one, except after giving up at the held load, where ``u`` (``load_factor``, ``relative_residual``) is
+    the held state with the smallest residual, accepted step ``kept_step`` (1-based; the residuals of a soft
+    structure's last held steps can rise and fall by several times)."""
 
     u: np.ndarray
     load_factor: float
@@ -190,6 +81,7 @@ class PseudoTransientResult:
     rejected: int = 0
     converged: bool = False
     relative_residual: float = math.inf
+    kept_step: int | None = None
     timings: dict[str, float] = field(default_factory=lambda: {"assembly": 0.0, "solve": 0.0})
 
 
@@ -246,6 +138,7 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
     held_from = 0 if t0 >= end else None  # index of the first accepted step at the held load
     relative = norm / reference_force(problem, residual, fixed)
     failure: Exception | None = None
+    best: tuple | None = None  # (residual norm, u, load factor, relative, step) of the best held state
     bar = tqdm(total=None if end == t0 else 100, disable=not progress, desc="pseudo-time", leave=False)
     try:
         while len(result.pseudo_times) < opts.max_steps:
@@ -255,23 +148,25 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
             held = result.residuals[held_from:] if held_from is not None else []
             if opts.stall_steps and len(held) > opts.stall_steps and \
                     min(held[-opts.stall_steps:]) > 0.5 * held[-opts.stall_steps - 1]:
-                raise _give_up(None, None, len(result.pseudo_times), t, result, dtau,
+                raise _give_up(None, None, len(result.pseudo_times), t, result, dtau, best,
                                reason=f"stalled: the residual at the held load fell by less than half in "
                                       f"{opts.stall_steps} pseudo-steps (relative {relative:.2e})")
             if dtau < opts.min_step:
                 error_type = NonPositiveJacobianError if isinstance(failure, NonPositiveJacobianError) else None
-                raise _give_up(error_type, failure, len(result.pseudo_times) + 1, t, result, dtau)
+                raise _give_up(error_type, failure, len(result.pseudo_times) + 1, t, result, dtau, best)
             if t < end:
                 dtau = min(dtau, opts.max_load_step)
             t_new = min(tau + dtau, end) if t < end else end
             if t < end and end - t_new < 1e-12 * max(1.0, end):
                 t_new = end
             step = len(result.pseudo_times) + 1
+            beta = opts.held_stiffness_damping if t >= end and opts.held_stiffness_damping is not None else \
+                opts.stiffness_damping(t_new) if callable(opts.stiffness_damping) else opts.stiffness_damping
             try:
                 local = np.where(boost > 1.0, floor, weights)
                 trial, trial_residual, trial_tangent, largest = _step(problem, u, t, t_new, dtau, tangent, local,
                                                                        boost, norm, opts, solver, step,
-                                                                       result.timings, edges)
+                                                                       result.timings, edges, float(beta))
             except _Rejected as err:
                 problem.rewind()
                 result.rejected += 1
@@ -301,6 +196,8 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
             for name, value in (("pseudo_times", tau), ("load_factors", t), ("step_lengths", dtau),
                                 ("residuals", norm), ("largest_increments", largest)):
                 getattr(result, name).append(value)
+            if t >= end and (best is None or norm < best[0]):
+                best = (norm, u, t, relative, step)
             if verbose:
                 print(f"pseudo-step {step} tau={tau:.5g} t={t:.5g} dtau={dtau:.3g} |R|={norm:.3e} rel={relative:.3e} "
                       f"max|du|={largest:.3g}", flush=True)
@@ -318,7 +215,7 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
                                              else 0.5))
             failure = None
         else:
-            raise _give_up(None, None, len(result.pseudo_times), t, result, dtau,
+            raise _give_up(None, None, len(result.pseudo_times), t, result, dtau, best,
                            reason=f"{opts.max_steps} pseudo-steps without converging")
     finally:
         bar.close()
@@ -326,7 +223,7 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
 
 
 def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent, weights, boost, norm: float,
-          opts: PseudoTransientOptions, solver: str, step: int, timings: dict, edges: tuple | None):
+          opts: PseudoTransientOptions, solver: str, step: int, timings: dict, edges: tuple | None, beta: float):
     """One linearised implicit-Euler step with the damping diagonal ``boost * (c weights + beta |diag K|)``;
     raises :class:`_Rejected` (with a cut ``factor`` and the ``nodes`` to damp) when it fails a test."""
     pattern = problem.pattern
@@ -344,7 +241,6 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
         trial[fixed] = new_values
     K = problem.tangent_matrix(tangent)
     diagonal = opts.damping * weights[free]
-    beta = float(opts.stiffness_damping(t_new)) if callable(opts.stiffness_damping) else opts.stiffness_damping
     if not (math.isfinite(beta) and beta >= 0.0):
         raise ValueError(f"stiffness_damping must be finite and >= 0; got {beta!r} at load factor {t_new}")
     if beta > 0.0:
@@ -433,13 +329,17 @@ def _checked_edges(problem: Problem, edges, rest_lengths) -> tuple[np.ndarray, n
     return pairs, rest, X
 
 
-def _give_up(error_type, cause, step: int, t: float, result: PseudoTransientResult, dtau: float,
+def _give_up(error_type, cause, step: int, t: float, result: PseudoTransientResult, dtau: float, best: tuple | None,
              reason: str | None = None):
+    if best is not None:  # at the held load: keep its best state, not merely the last
+        _, result.u, result.load_factor, result.relative_residual, result.kept_step = best
     if error_type is NonPositiveJacobianError and cause is not None:
         error = NonPositiveJacobianError(cause.elements, step, t)
     else:
         reason = reason or f"the pseudo-time step fell to {dtau:.2e} (last rejection: {cause})"
         error = ConvergenceError(f"pseudo-transient continuation stopped at pseudo-step {step}, load factor {t:.6g}: "
-                                 f"{reason}; last accepted load factor {result.load_factor:.6g}")
+                                 f"{reason}; last accepted load factor {result.load_factor:.6g}"
+                                 + (f"; kept the held state of pseudo-step {result.kept_step} (relative residual "
+                                    f"{result.relative_residual:.2e})" if result.kept_step is not None else ""))
     error.last_state = result
     return error
