@@ -147,6 +147,29 @@ def test_contact_tangent_matches_central_differences_with_fixed_active_set():
     assert np.allclose(K, K.T)
 
 
+def test_the_search_memory_saved_with_a_state_gives_back_its_active_set():
+    """Non-matching faces (2 on 3 cells): nodes of one face sit on edges of the other's triangles, where the search
+    keeps the triangle of its last search. The memory taken by ``state`` and given back by ``restore`` after other
+    searches (here one at the open state, which forgets every pair) reproduces the active set at the same ``u``."""
+    problem, contact = block_contact_problem(2, 3, 30.0)
+    u = np.zeros(problem.space.n_dofs)
+    X = problem.space.dof_coordinates
+    top = X[2] > 1.0 - 1e-9
+    top[: 27] = False
+    u[2::3][top] = -0.05
+    u += 0.01 * _random_state(2).normal(size=u.size)
+    before = contact.active_pairs(u)
+    memory = contact.state()
+    assert contact.active_pairs(np.zeros_like(u)).size == 0
+    assert np.all(contact.state()["previous_triangle"] == -1)
+    problem.restore({f"{problem.terms.index(contact)}/{key}": value for key, value in memory.items()})
+    after = contact.active_pairs(u)
+    assert before.size > 10
+    assert np.array_equal(before.node, after.node) and np.array_equal(before.triangle, after.triangle)
+    with pytest.raises(ValueError, match="previous_triangle"):
+        contact.restore({"previous_triangle": np.zeros(3, dtype=int)})
+
+
 def test_open_surfaces_have_no_pairs_and_own_neighbourhood_is_excluded():
     problem, contact = block_contact_problem(2, 2, 10.0, gap=0.1)
     assert contact.active_pairs(np.zeros(problem.space.n_dofs)).size == 0

@@ -103,6 +103,27 @@ def test_held_stiffness_damping_replaces_the_stiffness_damping_once_the_load_is_
         PseudoTransientOptions(held_stiffness_damping=-1.0)
 
 
+class _Memory(Term):
+    """No forces; counts its assemblies as a state (like a contact search's memory of the last active set)."""
+
+    def __init__(self) -> None:
+        self.assemblies = 0
+
+    def connectivity(self):
+        return []
+
+    def assemble(self, u, t, tangent, step):
+        self.assemblies += 1
+        return Contribution()
+
+    def state(self):
+        return {"assemblies": np.array([self.assemblies])}
+
+    def restore(self, arrays):
+        if "assemblies" in arrays:
+            self.assemblies = int(arrays["assemblies"][0])
+
+
 def test_giving_up_at_the_held_load_keeps_the_held_state_with_the_smallest_residual():
     """A linear chord (k = 1) pulled by 0.4 and pushed back by 0.3 once past u = 0.2: no equilibrium (0.4 below
     0.2, 0.1 above), so the held residual rises and falls around the jump. When the run gives up, its state is the
@@ -111,25 +132,29 @@ def test_giving_up_at_the_held_load_keeps_the_held_state_with_the_smallest_resid
 
     space, a, b = two_nodes()
     chord = Truss(space, [[a, b]], 0.5, LinearUniaxial(4.0))
+    memory = _Memory()
     problem = Problem(space, [chord, NodalForce(space, np.array([b]), [0.4, 0.0, 0.0], ramp=True),
-                              _JumpForce(space.n_dofs, 3 * b, 0.2, -0.3)])
+                              _JumpForce(space.n_dofs, 3 * b, 0.2, -0.3), memory])
     problem.add_dirichlet(nodes=np.setdiff1d(np.arange(space.n_scalar), [b]), value=0.0)
     problem.add_dirichlet(nodes=[b], value=0.0, components=[1, 2])
     weights = np.zeros(space.n_dofs)
     weights[3 * b] = 1.0
-    seen = []
+    seen, memories = [], {}
     options = PseudoTransientOptions(damping=1.0, first_step=0.5, max_load_step=0.5, max_increment=None,
                                      blow_up=1e6, max_steps=40, stall_steps=0)
     with pytest.raises(ConvergenceError, match="40 pseudo-steps") as info:
         pseudo_transient(problem, weights, 1.0, options, progress=False,
                          callbacks=[lambda event: seen.append((event.step, event.load_factor, event.residual_norm,
-                                                               event.u.copy()))])
+                                                               event.u.copy())),
+                                    lambda event: memories.update({event.step: memory.assemblies})])
     held = [event for event in seen if event[1] == 1.0]
     best = min(held, key=lambda event: event[2])
     kept = info.value.last_state
     assert held[-1][2] > 1.5 * best[2]  # the last held state is not the best one: the test can tell them apart
     assert kept.kept_step == best[0] and kept.load_factor == 1.0
     assert np.array_equal(kept.u, best[3])
+    # the terms' state is given back as it was at that step (what a re-evaluation of the kept state depends on)
+    assert memory.assemblies == memories[best[0]] < max(memories.values())
     # the jump is where the residual is smallest: the kept state sits next to it
     assert abs(kept.u[3 * b] - 0.2) < 0.1
 

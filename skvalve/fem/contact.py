@@ -300,6 +300,23 @@ class SurfaceContact(Term):
         self._previous[node[pick]] = triangle[pick]
         return ActivePairs(node[pick], triangle[pick], gap[pick], weights[pick])
 
+    def state(self) -> dict[str, np.ndarray]:
+        """The search's memory: the triangle each node had at the last search (-1: none). With ``u`` it fixes the
+        active set, which prefers those triangles (saved with a state that is to be evaluated again)."""
+        return {"previous_triangle": self._previous.copy()}
+
+    def restore(self, arrays: dict[str, np.ndarray]) -> None:
+        """Give back what :meth:`state` took (nothing given: nothing changes)."""
+        previous = arrays.get("previous_triangle")
+        if previous is None:
+            return
+        previous = np.asarray(previous)
+        if previous.shape != self._previous.shape or (previous.size and (
+                previous.min() < -1 or previous.max() >= self.surface.triangles.shape[0])):
+            raise ValueError(f"contact: previous_triangle must be {self._previous.shape[0]} triangle indices "
+                             f"(-1 for none); got shape {previous.shape}")
+        self._previous[:] = previous
+
     def _node_normals(self, x: np.ndarray) -> np.ndarray:
         Q = x[self.surface.quads]
         face = np.cross(Q[:, 2] - Q[:, 0], Q[:, 3] - Q[:, 1])

@@ -138,7 +138,7 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
     held_from = 0 if t0 >= end else None  # index of the first accepted step at the held load
     relative = norm / reference_force(problem, residual, fixed)
     failure: Exception | None = None
-    best: tuple | None = None  # (residual norm, u, load factor, relative, step) of the best held state
+    best: tuple | None = None  # (residual norm, u, load factor, relative, step, terms' state) of the best held state
     bar = tqdm(total=None if end == t0 else 100, disable=not progress, desc="pseudo-time", leave=False)
     try:
         while len(result.pseudo_times) < opts.max_steps:
@@ -148,12 +148,12 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
             held = result.residuals[held_from:] if held_from is not None else []
             if opts.stall_steps and len(held) > opts.stall_steps and \
                     min(held[-opts.stall_steps:]) > 0.5 * held[-opts.stall_steps - 1]:
-                raise _give_up(None, None, len(result.pseudo_times), t, result, dtau, best,
+                raise _give_up(problem, None, None, len(result.pseudo_times), t, result, dtau, best,
                                reason=f"stalled: the residual at the held load fell by less than half in "
                                       f"{opts.stall_steps} pseudo-steps (relative {relative:.2e})")
             if dtau < opts.min_step:
                 error_type = NonPositiveJacobianError if isinstance(failure, NonPositiveJacobianError) else None
-                raise _give_up(error_type, failure, len(result.pseudo_times) + 1, t, result, dtau, best)
+                raise _give_up(problem, error_type, failure, len(result.pseudo_times) + 1, t, result, dtau, best)
             if t < end:
                 dtau = min(dtau, opts.max_load_step)
             t_new = min(tau + dtau, end) if t < end else end
@@ -197,7 +197,7 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
                                 ("residuals", norm), ("largest_increments", largest)):
                 getattr(result, name).append(value)
             if t >= end and (best is None or norm < best[0]):
-                best = (norm, u, t, relative, step)
+                best = (norm, u, t, relative, step, problem.state())
             if verbose:
                 print(f"pseudo-step {step} tau={tau:.5g} t={t:.5g} dtau={dtau:.3g} |R|={norm:.3e} rel={relative:.3e} "
                       f"max|du|={largest:.3g}", flush=True)
@@ -215,7 +215,7 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
                                              else 0.5))
             failure = None
         else:
-            raise _give_up(None, None, len(result.pseudo_times), t, result, dtau, best,
+            raise _give_up(problem, None, None, len(result.pseudo_times), t, result, dtau, best,
                            reason=f"{opts.max_steps} pseudo-steps without converging")
     finally:
         bar.close()
@@ -329,10 +329,11 @@ def _checked_edges(problem: Problem, edges, rest_lengths) -> tuple[np.ndarray, n
     return pairs, rest, X
 
 
-def _give_up(error_type, cause, step: int, t: float, result: PseudoTransientResult, dtau: float, best: tuple | None,
-             reason: str | None = None):
+def _give_up(problem: Problem, error_type, cause, step: int, t: float, result: PseudoTransientResult, dtau: float,
+             best: tuple | None, reason: str | None = None):
     if best is not None:  # at the held load: keep its best state, not merely the last
-        _, result.u, result.load_factor, result.relative_residual, result.kept_step = best
+        _, result.u, result.load_factor, result.relative_residual, result.kept_step, terms = best
+        problem.restore(terms)  # e.g. a contact search's memory, so that the kept state evaluates as it did
     if error_type is NonPositiveJacobianError and cause is not None:
         error = NonPositiveJacobianError(cause.elements, step, t)
     else:
