@@ -22,7 +22,6 @@ from pathlib import Path
 import numpy as np
 
 from skvalve.fem.damping import undamped_residual
-from skvalve.fem.meshes import hex_corner_jacobians
 from skvalve.io.abaqus import read_model, trivalve_input
 from skvalve.io.files import replace_atomically
 from skvalve.papers.mathur2022.figures import write_figures
@@ -35,7 +34,8 @@ from skvalve.valve.closure import (
     run_closure,
     write_log,
 )
-from skvalve.valve.model import valve_model
+from skvalve.valve.extrude import hex_corner_jacobians
+from skvalve.valve.model import ABAQUS_TO_SKFEM_HEX, valve_model
 from skvalve.valve.outputs import ClosureWriter, closure_measures
 
 #: flags that override a ClosureOptions field of the same name: type and help
@@ -180,9 +180,10 @@ def main() -> int:
               f"{measures.coaptation_area:.1f}; centre max principal Cauchy stress "
               + ", ".join(f"{name} {1e3 * value:.2f}" for name, value in measures.centre_stress.items()))
         mesh = setup.model.mesh
-        corners = hex_corner_jacobians(mesh.p.T + run.u[: setup.problem.space.n_u].reshape(-1, 3), mesh.t.T)
+        corners = hex_corner_jacobians(mesh.p.T + run.u[: setup.problem.space.n_u].reshape(-1, 3),
+                                       mesh.t.T[:, np.argsort(ABAQUS_TO_SKFEM_HEX)])  # det(dx/dxi) at each corner
         print(f"hexes with a folded corner (corner Jacobian <= 0): {int((corners <= 0.0).any(axis=1).sum())} of "
-              f"{corners.shape[0]}; smallest corner Jacobian {corners.min():.3g} mm³")
+              f"{corners.shape[0]}; smallest corner Jacobian {corners.min():.3g} (det dx/dxi)")
         ClosureWriter(args.out / "final_state.pvd", setup).write(t, run.u)
         credit = "Texas TriValve " + ("1.1" if "1.1" in str(path) else "1.0") + " (Mathur et al. 2022), " + \
                  ("CC BY 4.0" if "1.1" in str(path) else "CC BY-NC-SA 4.0")

@@ -11,13 +11,7 @@ import dataclasses
 import numpy as np
 import skfem as fem
 
-__all__ = ["box", "rectangle", "annulus_sector", "spherical_shell_octant", "distort", "hex_corner_jacobians"]
-
-#: for each corner of a scikit-fem hexahedron (corner k of the unit cube at (x, y, z) = bits of
-#: (0,0,0), (0,0,1), (0,1,0), (1,0,0), (0,1,1), (1,0,1), (1,1,0), (1,1,1)): its neighbours along x, y, z, and
-#: the sign that makes the triple product of the three edges positive on the undistorted cube
-_CORNER_EDGES = np.array([(3, 2, 1), (5, 4, 0), (6, 0, 4), (0, 6, 5), (7, 1, 2), (1, 7, 3), (2, 3, 7), (4, 5, 6)])
-_CORNER_SIGNS = np.array([1.0, -1.0, -1.0, -1.0, 1.0, 1.0, 1.0, -1.0])
+__all__ = ["box", "rectangle", "annulus_sector", "spherical_shell_octant", "distort"]
 
 
 def _named(mesh: fem.Mesh, lengths) -> fem.Mesh:
@@ -142,19 +136,3 @@ def distort(mesh: fem.Mesh, amount: float = 0.2, seed: int = 0) -> fem.Mesh:
     on_box = np.isclose(p, lo) | np.isclose(p, hi)
     p = np.where(on_box, p, p + amount * h * rng.uniform(-1.0, 1.0, p.shape))
     return type(mesh)(p, mesh.t, _boundaries=mesh.boundaries, _subdomains=mesh.subdomains)
-
-
-def hex_corner_jacobians(points: np.ndarray, hexes: np.ndarray) -> np.ndarray:
-    r"""Jacobian of the trilinear map at the eight corners of each hexahedron, (n_hex, 8).
-
-    At a corner the map's derivatives are its three edges (times 1/2 for the :math:`[-1, 1]^3` reference, times 1
-    for the unit cube), so :math:`J = e_x\cdot(e_y\times e_z)`, signed to be positive on an undistorted cell. A
-    negative corner Jacobian means the element is folded there: its quadrature points (where the equations are
-    sampled) can all still be sound. ``points`` (n, 3) current coordinates, ``hexes`` (n_hex, 8) in
-    scikit-fem's corner order (``mesh.t.T``).
-    """
-    x = np.asarray(points, dtype=float)[np.asarray(hexes)]  # (n_hex, 8, 3)
-    corner = x[:, :, None, :]
-    edges = x[:, _CORNER_EDGES, :] - corner  # (n_hex, 8, 3 directions, 3)
-    triple = np.einsum("hki,hki->hk", edges[:, :, 0], np.cross(edges[:, :, 1], edges[:, :, 2]))
-    return triple * _CORNER_SIGNS

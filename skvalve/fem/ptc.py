@@ -85,6 +85,18 @@ class PseudoTransientResult:
     timings: dict[str, float] = field(default_factory=lambda: {"assembly": 0.0, "solve": 0.0})
 
 
+@dataclass
+class _Kept:
+    """The held state with the smallest residual so far, with the terms' state at that step."""
+
+    norm: float
+    u: np.ndarray
+    load_factor: float
+    relative: float
+    step: int
+    terms: dict[str, np.ndarray]
+
+
 class _Rejected(Exception):
     """A pseudo-step that failed a test: the factor to cut the step by, and the nodes to damp locally (if any)."""
 
@@ -138,7 +150,7 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
     held_from = 0 if t0 >= end else None  # index of the first accepted step at the held load
     relative = norm / reference_force(problem, residual, fixed)
     failure: Exception | None = None
-    best: tuple | None = None  # (residual norm, u, load factor, relative, step, terms' state) of the best held state
+    best: _Kept | None = None
     bar = tqdm(total=None if end == t0 else 100, disable=not progress, desc="pseudo-time", leave=False)
     try:
         while len(result.pseudo_times) < opts.max_steps:
@@ -160,8 +172,10 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
             if t < end and end - t_new < 1e-12 * max(1.0, end):
                 t_new = end
             step = len(result.pseudo_times) + 1
-            beta = opts.held_stiffness_damping if t >= end and opts.held_stiffness_damping is not None else \
-                opts.stiffness_damping(t_new) if callable(opts.stiffness_damping) else opts.stiffness_damping
+            if t >= end and opts.held_stiffness_damping is not None:
+                beta = opts.held_stiffness_damping
+            else:
+                beta = opts.stiffness_damping(t_new) if callable(opts.stiffness_damping) else opts.stiffness_damping
             try:
                 local = np.where(boost > 1.0, floor, weights)
                 trial, trial_residual, trial_tangent, largest = _step(problem, u, t, t_new, dtau, tangent, local,
@@ -196,8 +210,8 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
             for name, value in (("pseudo_times", tau), ("load_factors", t), ("step_lengths", dtau),
                                 ("residuals", norm), ("largest_increments", largest)):
                 getattr(result, name).append(value)
-            if t >= end and (best is None or norm < best[0]):
-                best = (norm, u, t, relative, step, problem.state())
+            if t >= end and (best is None or norm < best.norm):
+                best = _Kept(norm, u, t, relative, step, problem.state())
             if verbose:
                 print(f"pseudo-step {step} tau={tau:.5g} t={t:.5g} dtau={dtau:.3g} |R|={norm:.3e} rel={relative:.3e} "
                       f"max|du|={largest:.3g}", flush=True)
@@ -330,10 +344,11 @@ def _checked_edges(problem: Problem, edges, rest_lengths) -> tuple[np.ndarray, n
 
 
 def _give_up(problem: Problem, error_type, cause, step: int, t: float, result: PseudoTransientResult, dtau: float,
-             best: tuple | None, reason: str | None = None):
+             best: _Kept | None, reason: str | None = None):
     if best is not None:  # at the held load: keep its best state, not merely the last
-        _, result.u, result.load_factor, result.relative_residual, result.kept_step, terms = best
-        problem.restore(terms)  # e.g. a contact search's memory, so that the kept state evaluates as it did
+        result.u, result.load_factor, result.relative_residual = best.u, best.load_factor, best.relative
+        result.kept_step = best.step
+        problem.restore(best.terms)  # e.g. a contact search's memory, so that the kept state evaluates as it did
     if error_type is NonPositiveJacobianError and cause is not None:
         error = NonPositiveJacobianError(cause.elements, step, t)
     else:

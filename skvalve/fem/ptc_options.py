@@ -70,8 +70,8 @@ class PseudoTransientOptions:
     max_steps : int
         The most accepted pseudo-steps.
     stall_steps : int
-        Give up (``ConvergenceError``, last state kept) when, with the load held at ``end``, the residual has not
-        fallen below half its value of ``stall_steps`` steps before (0: never).
+        Give up (``ConvergenceError``, the best held state kept) when, with the load held at ``end``, the residual
+        has not fallen below half its value of ``stall_steps`` steps before (0: never).
     solver : str or None
         Sparse backend (:func:`skvalve.fem.linsolve.solver_name`).
     """
