@@ -50,6 +50,7 @@ OPTION_FLAGS = {
     "cable_slack_fraction": (float, "cable stiffness below the slack length, relative to the small-strain modulus"),
     "contact_from": (float, "step time from which the contact penalty acts"),
     "contact_exclude_within": (float, "node-face pairs closer than this (mm) in the reference never contact"),
+    "contact_blend": (float, "blended contact band beta (0: closest triangle)"),
     "contact_ramp": (float, "step-time interval over which the contact penalty rises smoothly to its value"),
     "penalty": (float, "contact penalty (MPa/mm)"),
     "cable_compression": (int, "1: cables that are one input truss carry their law in compression too"),
@@ -147,7 +148,7 @@ def main() -> int:
     if args.report:  # the kept state, measured and drawn, no solve
         run = ClosureRun(load_factors=[t0], iterations=[0], u=u0)
         setup.contact.assemble(u0, t0, False, None)
-        run.contact_pairs = [setup.contact.last_pairs.size]
+        run.contact_pairs = [setup.contact.last_pairs.touching]
         run.undamped_residual = undamped_residual(setup.problem, u0, t0)
     elif args.method == "ptc":
         ptc = {name: getattr(args, "ptc_" + name) for name in PTC_FLAGS if getattr(args, "ptc_" + name) is not None}

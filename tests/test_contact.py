@@ -20,17 +20,23 @@ def _random_state(seed: int = 0) -> np.random.Generator:
     return np.random.default_rng(seed)
 
 
-def test_gap_gradient_and_hessian_match_central_differences():
-    x = _random_state().normal(size=(6, 12))
-    g, grad, hess = gap_derivatives(x[:, :3], x[:, 3:6], x[:, 6:9], x[:, 9:])
-    h = 1e-6
+def pair_central_differences(derivatives, x: np.ndarray, h: float = 1e-6):
+    """For each of the 12 coordinates k of ``x`` (n, 12) = [xs, x1, x2, x3]: k and the central differences of the
+    value and of the gradient returned by ``derivatives(xs, x1, x2, x3)``."""
     for k in range(12):
         step = np.zeros(12)
         step[k] = h
-        plus = gap_derivatives(*np.split(x + step, 4, axis=1))
-        minus = gap_derivatives(*np.split(x - step, 4, axis=1))
-        np.testing.assert_allclose((plus[0] - minus[0]) / (2 * h), grad[:, k], atol=1e-8)
-        np.testing.assert_allclose((plus[1] - minus[1]) / (2 * h), hess[:, :, k], atol=1e-7)
+        plus = derivatives(*np.split(x + step, 4, axis=1))
+        minus = derivatives(*np.split(x - step, 4, axis=1))
+        yield k, (plus[0] - minus[0]) / (2 * h), (plus[1] - minus[1]) / (2 * h)
+
+
+def test_gap_gradient_and_hessian_match_central_differences():
+    x = _random_state().normal(size=(6, 12))
+    g, grad, hess = gap_derivatives(x[:, :3], x[:, 3:6], x[:, 6:9], x[:, 9:])
+    for k, value_slope, gradient_slope in pair_central_differences(gap_derivatives, x):
+        np.testing.assert_allclose(value_slope, grad[:, k], atol=1e-8)
+        np.testing.assert_allclose(gradient_slope, hess[:, :, k], atol=1e-7)
     # the gap is the signed distance to the plane: check against a direct construction
     normal = np.cross(x[:, 6:9] - x[:, 3:6], x[:, 9:] - x[:, 3:6])
     normal /= np.linalg.norm(normal, axis=1, keepdims=True)
@@ -49,7 +55,7 @@ def two_blocks(n_bottom: int, n_top: int, gap: float = 0.0) -> skfem.MeshHex:
 SMOOTHING = 0.01
 
 
-def block_contact_problem(n_bottom: int, n_top: int, penalty: float, gap: float = 0.0):
+def block_contact_problem(n_bottom: int, n_top: int, penalty: float, gap: float = 0.0, blend: float = 0.0):
     mesh = two_blocks(n_bottom, n_top, gap)
     space = Space(mesh)
     problem = Problem(space, [HyperelasticTerm(space, MaterialRegions(mesh, LAW))])
@@ -57,7 +63,7 @@ def block_contact_problem(n_bottom: int, n_top: int, penalty: float, gap: float 
     facets = np.concatenate([facets, mesh.facets_satisfying(lambda X: np.abs(X[2] - 1.0 - gap) < 1e-9,
                                                             boundaries_only=True)]) if gap else facets
     surface = ContactSurface.from_facets(mesh, facets)
-    contact = problem.add_term(SurfaceContact(space, surface, penalty, smoothing=SMOOTHING))
+    contact = problem.add_term(SurfaceContact(space, surface, penalty, smoothing=SMOOTHING, blend=blend))
     problem.add_dirichlet(lambda X: X[0] == 0.0, 0.0, components=[0])
     problem.add_dirichlet(lambda X: X[1] == 0.0, 0.0, components=[1])
     problem.add_dirichlet(lambda X: X[2] == 0.0, 0.0, components=[2])

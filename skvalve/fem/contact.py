@@ -53,6 +53,10 @@ and :math:`\partial^2 g/\partial a_i\partial b_j = \partial^2 g/\partial m^2` ma
 :math:`\varepsilon_{ijk} w_k` from the bilinearity of :math:`m`. The active set is found afresh at every
 assembly (the tangent is exact for a fixed set), so the tangent is returned as a sparse matrix on all dofs.
 
+With ``blend`` > 0 the closest-triangle rule (its dead zones over concave creases, its search memory) gives way
+to blended pairs (:mod:`skvalve.fem.contact_blend`): every nearby triangle carries a smooth share of the node's
+penalty energy :math:`\psi(h)` (:math:`\psi' = p`), whose gradient and Hessian are the force and tangent.
+
 Contact pressure (Abaqus CPRESS/CAREA): the nodal traction is the normal component of the total contact
 force on a node over its tributary area, :math:`p_i = \max(-f_i\cdot n_i, 0)/A_i`; a face's pressure is
 the mean over its nodes, and the contact area is the current area of the faces with positive pressure.
@@ -66,8 +70,13 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
+from .contact_blend import free_edges, pair_weights, weighted_mean_energy
+from .contact_geometry import barycentric, barycentric_derivatives, gap_derivatives, smooth_step
 from .space import Space
 from .terms import Contribution, Term
+
+#: Blended contact: the facing factor rises from 0 at -n_s.n = opposing to 1 this much above it.
+FACING_BAND = 0.2
 
 __all__ = ["ContactSurface", "ActivePairs", "SurfaceContact", "gap_derivatives", "oriented_quads"]
 
@@ -142,55 +151,6 @@ class ContactSurface:
         return cls.from_quads(mesh.p.T, mesh.facets[:, facets].T, inside)
 
 
-def gap_derivatives(xs: np.ndarray, x1: np.ndarray, x2: np.ndarray, x3: np.ndarray, hessian: bool = True):
-    """Gap ``g`` (n,), gradient (n, 12) and Hessian (n, 12, 12) w.r.t. ``[xs, x1, x2, x3]`` (module docstring)."""
-    d, a, b = xs - x1, x2 - x1, x3 - x1
-    m = np.cross(a, b)
-    mu = np.linalg.norm(m, axis=1)
-    n = m / mu[:, None]
-    g = np.einsum("ij,ij->i", d, n)
-    Pd = d - g[:, None] * n
-    w = Pd / mu[:, None]
-    grad_dab = np.hstack([n, np.cross(b, w), np.cross(w, a)])  # w.r.t. (d, a, b)
-    T = _chain_matrix()
-    grad = grad_dab @ T
-    if not hessian:
-        return g, grad, None
-    eye = np.eye(3)
-    P = eye - n[:, :, None] * n[:, None, :]
-    H_mm = -(g[:, None, None] * P + n[:, :, None] * Pd[:, None, :] + Pd[:, :, None] * n[:, None, :]) \
-        / (mu**2)[:, None, None]
-    J_m = np.concatenate([-_skew(b), _skew(a)], axis=2)  # (n, 3, 6): dm/d(a, b)
-    H = np.zeros((xs.shape[0], 9, 9))
-    H[:, :3, 3:] = (P / mu[:, None, None]) @ J_m
-    H[:, 3:, :3] = H[:, :3, 3:].transpose(0, 2, 1)
-    H[:, 3:, 3:] = J_m.transpose(0, 2, 1) @ H_mm @ J_m
-    M = np.einsum("ijk,nk->nij", _LEVI_CIVITA, w)  # d2g/da_i db_j from the bilinear m = a x b
-    H[:, 3:6, 6:] += M
-    H[:, 6:, 3:6] += M.transpose(0, 2, 1)
-    return g, grad, T.T @ H @ T
-
-
-_LEVI_CIVITA = np.zeros((3, 3, 3))
-for _i, _j, _k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
-    _LEVI_CIVITA[_i, _j, _k], _LEVI_CIVITA[_i, _k, _j] = 1.0, -1.0
-
-
-def _skew(v: np.ndarray) -> np.ndarray:
-    """[v]_x with [v]_x y = v x y, shape (n, 3, 3)."""
-    return -np.einsum("ijk,nk->nij", _LEVI_CIVITA, v)
-
-
-def _chain_matrix() -> np.ndarray:
-    """(9, 12) map from node coordinates [xs, x1, x2, x3] to (d, a, b) = (xs - x1, x2 - x1, x3 - x1)."""
-    eye = np.eye(3)
-    T = np.zeros((9, 12))
-    T[0:3, 0:3], T[0:3, 3:6] = eye, -eye
-    T[3:6, 6:9], T[3:6, 3:6] = eye, -eye
-    T[6:9, 9:12], T[6:9, 3:6] = eye, -eye
-    return T
-
-
 @dataclass
 class ActivePairs:
     """Active node-triangle pairs at one state: slave node, triangle, gap and barycentric coordinates."""
@@ -199,10 +159,16 @@ class ActivePairs:
     triangle: np.ndarray   # (n,) triangle index into ContactSurface.triangles
     gap: np.ndarray        # (n,) signed gap (< 0)
     weights: np.ndarray    # (n, 3) barycentric coordinates of the projection
+    facing: np.ndarray | None = None  # (n,) blended contact: the smooth opposing-normals factor (lagged)
 
     @property
     def size(self) -> int:
         return int(self.node.size)
+
+    @property
+    def touching(self) -> int:
+        """Pairs whose node has passed through its face (blended contact also lists pairs just above it)."""
+        return int(np.count_nonzero(self.gap < 0.0))
 
 
 class SurfaceContact(Term):
@@ -220,6 +186,9 @@ class SurfaceContact(Term):
     smoothing : :math:`h_0`, the overlap over which the penalty is rounded (default 1 % of the mean edge).
     exclude_within : a node never contacts a triangle whose reference centroid lies closer than this (self-contact of
         a thick surface: across a free edge's rim the two skins are a thickness apart and, bent, seem to overlap).
+    blend : 0 (default) for the closest-triangle rule; a band beta in (0, 0.5] for blended contact
+        (:mod:`skvalve.fem.contact_blend`: every triangle near a node takes a smooth share, no search memory, energy
+        continuous with its gradient across triangle edges; ``tolerance`` is then unused).
     """
 
     name = "contact"
@@ -227,7 +196,7 @@ class SurfaceContact(Term):
 
     def __init__(self, space: Space, surface: ContactSurface, penalty, max_penetration: float | None = None,
                  exclude_rings: int = 2, opposing: float = 0.2, tolerance: float = 0.05,
-                 smoothing: float | None = None, exclude_within: float = 0.0) -> None:
+                 smoothing: float | None = None, exclude_within: float = 0.0, blend: float = 0.0) -> None:
         if space.dim != 3 or space.order != 1:
             raise ValueError("contact: needs a linear 3D displacement space")
         if surface.nodes.max() >= space.n_scalar:
@@ -250,10 +219,17 @@ class SurfaceContact(Term):
         if not (np.isfinite(exclude_within) and exclude_within >= 0.0):
             raise ValueError(f"contact: exclude_within must be finite and >= 0; got {exclude_within!r}")
         self.exclude_within = float(exclude_within)
+        if not (0.0 <= blend <= 0.5):
+            raise ValueError(f"contact: blend must lie in [0, 0.5]; got {blend!r}")
+        self.blend = float(blend)
+        self._free_edges = free_edges(surface.triangles) if self.blend > 0.0 else None
         self._reference_centroids = self.X[surface.triangles].mean(axis=1)
         self.last_pairs: ActivePairs | None = None
         self._previous = np.full(space.n_scalar, -1, dtype=np.int64)  # triangle of each node at the last search
         self.last_force = np.zeros(space.n_u)
+        self.last_energy = 0.0
+        self._assembled_u: np.ndarray | None = None
+        self._committed_u: np.ndarray | None = None  # blended contact: the state whose normals give the facing
 
     # ------------------------------------------------------------------ search
     def active_pairs(self, u: np.ndarray) -> ActivePairs:
@@ -281,10 +257,12 @@ class SurfaceContact(Term):
         m = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
         normal = m / np.linalg.norm(m, axis=1, keepdims=True)
         gap = np.einsum("ij,ij->i", x[node] - c[:, 0], normal)
+        if self.blend > 0.0:
+            return self._blended_candidates(x, node, triangle, gap, c)
         ok = (gap < 0.0) & (gap > -self.max_penetration)
         ok &= np.einsum("ij,ij->i", self._node_normals(x)[node], normal) < -self.opposing
         node, triangle, gap, c, normal = node[ok], triangle[ok], gap[ok], c[ok], normal[ok]
-        weights = _barycentric(x[node] - gap[:, None] * normal, c)
+        weights = barycentric(x[node], c)
         inside = weights.min(axis=1)
         ok = inside >= -self.tolerance
         node, triangle, gap, weights, inside = node[ok], triangle[ok], gap[ok], weights[ok], inside[ok]
@@ -300,13 +278,53 @@ class SurfaceContact(Term):
         self._previous[node[pick]] = triangle[pick]
         return ActivePairs(node[pick], triangle[pick], gap[pick], weights[pick])
 
+    def _blended_candidates(self, x, node, triangle, gap, corners) -> ActivePairs:
+        r"""Every pair whose blended share is positive (:mod:`~skvalve.fem.contact_blend`), with its facing factor
+        :math:`S((-n_s\cdot n - c)/0.2)` taken at the last committed state (lagged: a node normal depends on the
+        node's neighbours, outside the pair; frozen within a step, the factor leaves the energy a function of the
+        pair's four nodes and still switches a pair on and off smoothly as the normals turn)."""
+        ok = (gap < self.above) & (gap > -self.max_penetration)
+        node, triangle, gap, corners = node[ok], triangle[ok], gap[ok], corners[ok]
+        weights = barycentric(x[node], corners)
+        lower = np.where(self._free_edges[triangle], -2.0 * self.blend, -self.blend)
+        ok = np.all(weights > lower, axis=1)
+        node, triangle, gap, weights = node[ok], triangle[ok], gap[ok], weights[ok]
+        x0 = x if self._committed_u is None else self.X + self._committed_u[: self.space.n_u].reshape(-1, 3)
+        c0 = x0[self.surface.triangles[triangle]]
+        m0 = np.cross(c0[:, 1] - c0[:, 0], c0[:, 2] - c0[:, 0])
+        cosine = np.einsum("ij,ij->i", self._node_normals(x0)[node], m0 / np.linalg.norm(m0, axis=1, keepdims=True))
+        facing = smooth_step((-cosine - self.opposing) / FACING_BAND)[0]
+        ok = facing > 0.0
+        return ActivePairs(node[ok], triangle[ok], gap[ok], weights[ok], facing[ok])
+
+    def commit(self) -> None:
+        """Blended contact: the last assembled state becomes the one whose normals set the facing factors."""
+        if self.blend > 0.0 and self._assembled_u is not None:
+            self._committed_u = self._assembled_u
+
+    @property
+    def above(self) -> float:
+        """g_a of blended contact: a triangle this far above a node still counts in its normalisation."""
+        return 0.25 * self.max_penetration
+
     def state(self) -> dict[str, np.ndarray]:
         """The search's memory: the triangle each node had at the last search (-1: none). With ``u`` it fixes the
-        active set, which prefers those triangles (saved with a state that is to be evaluated again)."""
-        return {"previous_triangle": self._previous.copy()}
+        active set, which prefers those triangles (saved with a state that is to be evaluated again). Blended
+        contact: the committed displacement whose normals set the facing factors (if any)."""
+        out = {"previous_triangle": self._previous.copy()}
+        if self._committed_u is not None:
+            out["committed_displacement"] = self._committed_u.copy()
+        return out
 
     def restore(self, arrays: dict[str, np.ndarray]) -> None:
         """Give back what :meth:`state` took (nothing given: nothing changes)."""
+        committed = arrays.get("committed_displacement")
+        if committed is not None:
+            committed = np.asarray(committed, dtype=float)
+            if committed.shape != (self.space.n_dofs,) or not np.all(np.isfinite(committed)):
+                raise ValueError(f"contact: committed_displacement must be {self.space.n_dofs} finite values; got "
+                                 f"shape {committed.shape}")
+            self._committed_u = committed.copy()
         previous = arrays.get("previous_triangle")
         if previous is None:
             return
@@ -327,6 +345,7 @@ class SurfaceContact(Term):
 
     # ---------------------------------------------------------------- assembly
     def assemble(self, u: np.ndarray, t: float, tangent: bool, step: int | None) -> Contribution:
+        self._assembled_u = np.array(u, dtype=float)
         pairs = self.active_pairs(u)
         return self.assemble_pairs(u, t, pairs, tangent)
 
@@ -337,14 +356,19 @@ class SurfaceContact(Term):
         internal = np.zeros(n_dofs)
         if pairs.size == 0:
             self.last_force = np.zeros(self.space.n_u)
+            self.last_energy = 0.0
             return Contribution(internal=internal, matrix=sp.csr_matrix((n_dofs, n_dofs)) if tangent else None)
         x = self.X + u[: self.space.n_u].reshape(-1, 3)
         tri = self.surface.triangles[pairs.triangle]
-        g, grad, hess = gap_derivatives(x[pairs.node], x[tri[:, 0]], x[tri[:, 1]], x[tri[:, 2]], tangent)
+        corners = (x[pairs.node], x[tri[:, 0]], x[tri[:, 1]], x[tri[:, 2]])
+        g, grad, hess = gap_derivatives(*corners, tangent)
         pressure, stiffness = self.pressure_law(-g, float(self.penalty(t)))
-        area = self.area[pairs.node]
         dofs = (3 * np.column_stack([pairs.node, tri])[:, :, None] + np.arange(3)).reshape(-1, 12)
+        if self.blend > 0.0:
+            return self._assemble_blended(pairs, corners, (g, grad, hess), (pressure, stiffness), dofs, t, tangent)
+        area = self.area[pairs.node]
         forces = -(area * pressure)[:, None] * grad
+        self.last_energy = float(np.sum(area * self.penalty_energy(-g, float(self.penalty(t)))))
         np.add.at(internal, dofs.ravel(), forces.ravel())
         self.last_force = internal[: self.space.n_u].copy()
         matrix = None
@@ -355,6 +379,44 @@ class SurfaceContact(Term):
             cols = np.tile(dofs, (1, 12)).ravel()
             matrix = sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(n_dofs, n_dofs))
         return Contribution(internal=internal, matrix=matrix)
+
+    def _assemble_blended(self, pairs, corners, gap, law, dofs, t, tangent) -> Contribution:
+        """Blended contact (:mod:`skvalve.fem.contact_blend`) of the candidate pairs."""
+        g, g_grad, g_hess = gap
+        pressure, stiffness = law
+        overlap = np.maximum(-g, 0.0)
+        pressure, stiffness = np.where(g < 0.0, pressure, 0.0), np.where(g < 0.0, stiffness, 0.0)
+        psi = self.penalty_energy(overlap, float(self.penalty(t)))
+        psi_grad = -pressure[:, None] * g_grad
+        psi_hess = None
+        if tangent:
+            psi_hess = stiffness[:, None, None] * g_grad[:, :, None] * g_grad[:, None, :] \
+                - pressure[:, None, None] * g_hess
+        lam, lam_grad, lam_hess = barycentric_derivatives(*corners)
+        phi, phi_grad, phi_hess = pair_weights(lam, lam_grad, lam_hess, g, g_grad, g_hess,
+                                               self._free_edges[pairs.triangle], self.blend, self.max_penetration,
+                                               self.above, tangent)
+        facing = np.ones(pairs.size) if pairs.facing is None else pairs.facing
+        phi, phi_grad = facing * phi, facing[:, None] * phi_grad
+        if tangent:
+            phi_hess = facing[:, None, None] * phi_hess
+        internal, matrix, self.last_energy = weighted_mean_energy(
+            pairs.node, dofs, self.area, phi, phi_grad, phi_hess, psi, psi_grad, psi_hess, self.space.n_dofs, tangent)
+        self.last_force = internal[: self.space.n_u].copy()
+        return Contribution(internal=internal, matrix=matrix)
+
+    def energy(self, u: np.ndarray, t: float = 1.0) -> float:
+        """The contact energy at ``u`` (load factor ``t`` for the penalty): its gradient is the internal force."""
+        self.assemble(u, t, False, None)
+        return self.last_energy
+
+    def penalty_energy(self, overlap: np.ndarray, penalty: float) -> np.ndarray:
+        """Penalty energy per area psi(h) with psi' = p(h) (:meth:`pressure_law`), zero at h = 0."""
+        h0 = self.smoothing
+        if h0 == 0.0:
+            return 0.5 * penalty * overlap**2
+        return np.where(overlap < h0, penalty * overlap**3 / (6.0 * h0),
+                        penalty * (0.5 * overlap**2 - 0.5 * h0 * overlap + h0**2 / 6.0))
 
     def pressure_law(self, overlap: np.ndarray, penalty: float) -> tuple[np.ndarray, np.ndarray]:
         """Contact pressure p(h) and dp/dh for overlaps ``h`` >= 0 (module docstring)."""
@@ -405,17 +467,6 @@ def _constant(value: float, name: str):
 def _no_pairs() -> ActivePairs:
     empty = np.zeros(0, dtype=np.int64)
     return ActivePairs(empty, empty, np.zeros(0), np.zeros((0, 3)))
-
-
-def _barycentric(p: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """Barycentric coordinates (n, 3) of points ``p`` (n, 3) in the planes of triangles ``c`` (n, 3, 3)."""
-    v0, v1, v2 = c[:, 1] - c[:, 0], c[:, 2] - c[:, 0], p - c[:, 0]
-    d00, d01, d11 = (np.einsum("ij,ij->i", v0, v0), np.einsum("ij,ij->i", v0, v1), np.einsum("ij,ij->i", v1, v1))
-    d20, d21 = np.einsum("ij,ij->i", v2, v0), np.einsum("ij,ij->i", v2, v1)
-    denom = d00 * d11 - d01 * d01
-    beta = (d11 * d20 - d01 * d21) / denom
-    gamma = (d00 * d21 - d01 * d20) / denom
-    return np.column_stack([1.0 - beta - gamma, beta, gamma])
 
 
 def _neighbourhood_keys(surface: ContactSurface, rings: int) -> np.ndarray:

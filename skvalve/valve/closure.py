@@ -73,6 +73,8 @@ class ClosureOptions:
     contact_exclude_within : node-face pairs whose reference distance is below this never contact
     (:class:`~skvalve.fem.contact.SurfaceContact` ``exclude_within``; on the 1.0 valve the only pairs of the papillary
     stage were rim nodes against the inner face of their own leaflet 0.5 mm away, across the 0.78 mm thick corner).
+    contact_blend : 0 for closest-triangle contact; a band beta > 0 for blended contact, whose energy is continuous
+    across triangle edges and has no search memory (:class:`~skvalve.fem.contact.SurfaceContact` ``blend``).
     contact_ramp : the penalty rises from zero at ``contact_from`` to ``penalty`` over this step-time interval (a smooth
     step): folds that overlap when it switches on are pushed apart gradually (switched on at once, three overlapping
     pairs at the free edge of the 1.0 valve threw their nodes by millimetres and stalled the pseudo-time steps at
@@ -115,6 +117,7 @@ class ClosureOptions:
     contact_from: float = 0.5
     contact_ramp: float = 0.0
     contact_exclude_within: float = 0.0
+    contact_blend: float = 0.0
     cable_slack_fraction: float = 1e-6
     cable_compression: bool = False
     pressure_damping: float = 1e-4
@@ -214,7 +217,8 @@ def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: Abaq
     penalty = options.penalty if options.contact_from <= 0.0 and options.contact_ramp <= 0.0 else \
         _PenaltyFrom(options.penalty, options.contact_from, options.contact_ramp)
     contact = problem.add_term(SurfaceContact(problem.space, surface, penalty, max_penetration=depth,
-                                              exclude_within=options.contact_exclude_within))
+                                              exclude_within=options.contact_exclude_within,
+                                              blend=options.contact_blend))
     damping = None
     if options.damping > 0.0:
         schedule = StagedDamping(options.damping, options.pressure_damping, options.pressure_start,
@@ -244,7 +248,7 @@ def run_closure(setup: ClosureSetup, options: ClosureOptions | None = None, call
         stage_timings[id(event.result)] = event.result.timings  # cumulative per solve: setup, assembly, solve
         run.load_factors.append(float(event.load_factor))
         run.iterations.append(len(event.result.histories[-1]))
-        run.contact_pairs.append(setup.contact.last_pairs.size if setup.contact.last_pairs is not None else 0)
+        run.contact_pairs.append(setup.contact.last_pairs.touching if setup.contact.last_pairs is not None else 0)
         run.u = event.u
 
     start = time.perf_counter()
@@ -342,7 +346,7 @@ def relax_closure(setup: ClosureSetup, end: float,
     def record(event) -> None:
         run.load_factors.append(float(event.load_factor))
         run.iterations.append(1)
-        run.contact_pairs.append(setup.contact.last_pairs.size if setup.contact.last_pairs is not None else 0)
+        run.contact_pairs.append(setup.contact.last_pairs.touching if setup.contact.last_pairs is not None else 0)
         run.u = event.u
 
     edges, rest_lengths = watched_edges(setup.model) if setup.model is not None else (None, None)
