@@ -239,7 +239,7 @@ class SurfaceContact(Term):
         tri = surface.triangles
         corners = x[tri]  # (nt, 3, 3)
         centroid = corners.mean(axis=1)
-        radius = np.linalg.norm(corners - centroid[:, None], axis=2).max() + self.max_penetration
+        radius = self.search_radius(corners, centroid)
         tree = cKDTree(centroid)
         slaves = surface.nodes
         lists = tree.query_ball_point(x[slaves], radius)
@@ -277,6 +277,14 @@ class SurfaceContact(Term):
         self._previous[:] = -1
         self._previous[node[pick]] = triangle[pick]
         return ActivePairs(node[pick], triangle[pick], gap[pick], weights[pick])
+
+    def search_radius(self, corners: np.ndarray, centroid: np.ndarray) -> float:
+        """Distance from a triangle's centroid within which every node it can pair with lies: a projection whose
+        barycentric coordinates are >= -band lies in the triangle scaled by 1 + 3 band about its centroid, so within
+        (1 + 3 band) r of it (r the largest centroid-corner distance), and the node within the search depth of it."""
+        band = 2.0 * self.blend if self.blend > 0.0 else self.tolerance
+        return (1.0 + 3.0 * band) * float(np.linalg.norm(corners - centroid[:, None], axis=2).max()) \
+            + self.max_penetration
 
     def _blended_candidates(self, x, node, triangle, gap, corners) -> ActivePairs:
         r"""Every pair whose blended share is positive (:mod:`~skvalve.fem.contact_blend`), with its facing factor
