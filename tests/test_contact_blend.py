@@ -8,7 +8,7 @@ from test_contact import block_contact_problem, closed_form_force, pair_central_
 
 from skvalve.fem import solve
 from skvalve.fem.contact import SurfaceContact
-from skvalve.fem.contact_blend import free_edges, normalisation
+from skvalve.fem.contact_blend import free_edges, normalisation, sheets, weighted_mean_energy
 from skvalve.fem.contact_geometry import barycentric_derivatives, smooth_step
 
 BLEND = 0.1
@@ -210,3 +210,23 @@ def test_the_search_radius_misses_no_pair():
                 del contact.search_radius
                 assert np.array_equal(found.node, everything.node)
                 assert np.array_equal(found.triangle, everything.triangle)
+
+
+def test_a_node_between_two_sheets_feels_each_in_full():
+    """Shares are normalised per sheet: a node pressed into one sheet (share 1, energy psi) with another sheet's
+    triangle just above it (share 0.8, no energy) keeps the energy psi; normalised together it would be psi / 1.8.
+    The sheets are the node's triangles connected through shared vertices."""
+    triangles = np.array([[0, 1, 2], [1, 2, 3], [10, 11, 12]])
+    node = np.array([20, 20, 20])
+    group = sheets(node, triangles)
+    assert group[0] == group[1] != group[2]
+    assert np.unique(sheets(np.array([20, 21]), triangles[:2])).size == 2  # other nodes: other groups
+    dofs = (3 * np.column_stack([node, triangles])[:, :, None] + np.arange(3)).reshape(-1, 12)
+    zeros = np.zeros((3, 12))
+    phi, psi = np.array([1.0, 0.0, 0.8]), np.array([0.5, 0.0, 0.0])
+    area = np.zeros(21)
+    area[20] = 2.0
+    hess = np.zeros((3, 12, 12))
+    for groups, expected in ((group, 2.0 * 0.5), (np.zeros(3, dtype=int), 2.0 * 0.5 / 1.8)):
+        _, _, energy = weighted_mean_energy(node, groups, dofs, area, phi, zeros, hess, psi, zeros, hess, 63, True)
+        assert energy == pytest.approx(expected)

@@ -70,7 +70,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from .contact_blend import free_edges, pair_weights, weighted_mean_energy
+from .contact_blend import free_edges, pair_weights, sheets, weighted_mean_energy
 from .contact_geometry import barycentric, barycentric_derivatives, gap_derivatives, smooth_step
 from .space import Space
 from .terms import Contribution, Term
@@ -408,8 +408,10 @@ class SurfaceContact(Term):
         phi, phi_grad = facing * phi, facing[:, None] * phi_grad
         if tangent:
             phi_hess = facing[:, None, None] * phi_hess
+        group = sheets(pairs.node, self.surface.triangles[pairs.triangle])
         internal, matrix, self.last_energy = weighted_mean_energy(
-            pairs.node, dofs, self.area, phi, phi_grad, phi_hess, psi, psi_grad, psi_hess, self.space.n_dofs, tangent)
+            pairs.node, group, dofs, self.area, phi, phi_grad, phi_hess, psi, psi_grad, psi_hess, self.space.n_dofs,
+            tangent)
         self.last_force = internal[: self.space.n_u].copy()
         return Contribution(internal=internal, matrix=matrix)
 

@@ -16,11 +16,14 @@ with :math:`\lambda_i` the barycentric coordinates of the node's projection (:mo
 triangles of equal height the shares sum to one (:math:`S(t)+S(1-t)=1`), and past a free edge the surface is
 extended by :math:`2\beta` as the closest-triangle band does. :math:`\chi(g)` fades a pair in over
 :math:`g_\text{max} > -g > 0.8\,g_\text{max}` (too deep) and out over :math:`0 < g < g_a` (not yet touching), so a
-triangle just above a node still counts in the node's normalisation. The node's energy is the weighted mean
+triangle just above a node still counts in the node's normalisation. The node's energy on each sheet :math:`k` (its
+pairs whose triangles connect through shared vertices: a node pressed between two sheets feels each in full) is the
+weighted mean
 
 .. math::
 
-    E_s = A_s\,\frac{N_s}{M(\Phi_s)},\qquad N_s = \sum_j \phi_j\,\psi(-g_j),\qquad \Phi_s = \sum_j \phi_j,
+    E_{s,k} = A_s\,\frac{N}{M(\Phi)},\qquad N = \sum_{j\in k} \phi_j\,\psi(-g_j),\qquad
+    \Phi = \sum_{j\in k} \phi_j,
 
 with :math:`\psi` the penalty energy (:math:`\psi' = p`) and :math:`M(\Phi) = \Phi` for :math:`\Phi \ge 1`,
 :math:`1 - \delta + (\Phi - 1 + 2\delta)^2/(4\delta)` on :math:`[1-2\delta, 1]` and :math:`1-\delta` below
@@ -42,10 +45,11 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
 from .contact_geometry import smooth_step
 
-__all__ = ["free_edges", "pair_weights", "weighted_mean_energy", "DEEP_FADE", "NORMALISATION_DELTA"]
+__all__ = ["free_edges", "pair_weights", "sheets", "weighted_mean_energy", "DEEP_FADE", "NORMALISATION_DELTA"]
 
 #: The fade-in of deep pairs starts at this fraction of the search depth g_max.
 DEEP_FADE = 0.8
@@ -111,14 +115,27 @@ def normalisation(total: np.ndarray, delta: float = NORMALISATION_DELTA):
     return value, first, second
 
 
-def weighted_mean_energy(node, dofs, area, phi, phi_grad, phi_hess, psi, psi_grad, psi_hess, n_dofs: int,
-                         tangent: bool):
-    """Internal force (n_dofs,) and tangent (sparse or ``None``) of :math:`\\sum_s A_s N_s/M(\\Phi_s)`.
+def sheets(node: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """Group id (n,) of each pair: the pairs of one node whose triangles are connected through shared vertices (one
+    sheet of the surface; a node between two sheets gets one group per sheet). ``triangles`` (n, 3) vertex ids."""
+    n = node.size
+    if n == 0:
+        return np.zeros(0, dtype=np.int64)
+    _, key = np.unique(np.column_stack([np.repeat(node, 3), triangles.ravel()]), axis=0, return_inverse=True)
+    incidence = sp.csr_matrix((np.ones(3 * n), (np.repeat(np.arange(n), 3), key.ravel())), shape=(n, key.max() + 1))
+    return connected_components(incidence @ incidence.T, directed=False)[1].astype(np.int64)
 
-    Per pair: ``node`` (n,), ``dofs`` (n, 12), ``phi``/``psi`` with gradients (n, 12) and Hessians (n, 12, 12);
-    ``area`` (n_nodes,) the tributary areas indexed by node. Also returns the energy.
+
+def weighted_mean_energy(node, group, dofs, area, phi, phi_grad, phi_hess, psi, psi_grad, psi_hess, n_dofs: int,
+                         tangent: bool):
+    """Internal force (n_dofs,) and tangent (sparse or ``None``) of :math:`\\sum_g A_{s(g)} N_g/M(\\Phi_g)`.
+
+    Per pair: ``node`` (n,), its ``group`` (n,) (:func:`sheets`: the normalisation runs over one node's pairs on
+    one sheet), ``dofs`` (n, 12), ``phi``/``psi`` with gradients (n, 12) and Hessians (n, 12, 12); ``area``
+    (n_nodes,) the tributary areas indexed by node. Also returns the energy.
     """
-    active, row = np.unique(node, return_inverse=True)
+    _, first, row = np.unique(group, return_index=True, return_inverse=True)
+    active = node[first]
     numerator = phi * psi
     numerator_grad = phi[:, None] * psi_grad + psi[:, None] * phi_grad
     N = np.bincount(row, numerator, minlength=active.size)
