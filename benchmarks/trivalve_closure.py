@@ -79,6 +79,8 @@ PTC_FLAGS = {
     "local_damping": (float, "factor on the damping of nodes that break a trust region (1: off)"),
     "max_strain_increment": (float, "trust region: largest change of an edge's or cable's tensile stretch per step"),
     "held_growth": (float, "smallest growth of the pseudo-time step per accepted step at the held load"),
+    "local_decay": (float, "factor by which local damping fades per accepted step"),
+    "stall_steps": (int, "give up when the held residual has not halved in this many steps (0: never)"),
 }
 
 

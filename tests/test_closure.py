@@ -32,7 +32,7 @@ from skvalve.valve.model import valve_model
 from skvalve.valve.outputs import ClosureWriter
 
 
-def _blocks_setup(shortening: float, damped: bool = True) -> ClosureSetup:
+def _blocks_setup(shortening: float, damped: bool = True, blend: float = 0.0) -> ClosureSetup:
     """Two unit cubes (2x2x2 hexes each) on rollers, the top face pushed down by ``shortening`` x t/end."""
     bottom = skfem.MeshHex.init_tensor(*(np.linspace(0, 1, 3),) * 3)
     top = skfem.MeshHex.init_tensor(*(np.linspace(0, 1, 3),) * 2, np.linspace(1, 2, 3))
@@ -40,7 +40,7 @@ def _blocks_setup(shortening: float, damped: bool = True) -> ClosureSetup:
     space = Space(mesh)
     problem = Problem(space, [HyperelasticTerm(space, MaterialRegions(mesh, NeoHookean(1.0, 2.0)))])
     surface = ContactSurface.from_facets(mesh, mesh.facets_satisfying(lambda X: np.abs(X[2] - 1) < 1e-9, True))
-    contact = problem.add_term(SurfaceContact(space, surface, 50.0, smoothing=0.01))
+    contact = problem.add_term(SurfaceContact(space, surface, 50.0, smoothing=0.01, blend=blend))
     damping = problem.add_term(ViscousDamping(space, DampingSchedule(0.5, t_off=1.0))) if damped else None
     for axis in range(3):
         problem.add_dirichlet(lambda X, a=axis: X[a] == 0.0, 0.0, components=[axis])
@@ -79,6 +79,13 @@ def test_pseudo_transient_closure_ends_where_the_load_stepped_one_does():
     assert relaxed.undamped_residual[1] < 1e-9
     with pytest.raises(ValueError, match="damping=0"):
         relax_closure(_blocks_setup(0.15), 1.5, progress=False)
+    # blended contact (matching faces: every node on a vertex or an edge, shares summing to one or more) closes to
+    # the same equilibrium, its facing factors committed with each accepted step
+    blended = relax_closure(_blocks_setup(0.15, damped=False, blend=0.1), 1.5,
+                            PseudoTransientOptions(damping=0.5, first_step=0.05, max_load_step=0.25, rtol=1e-9,
+                                                   solver="scipy"), progress=False)
+    assert blended.error is None and blended.contact_pairs[-1] == 18
+    np.testing.assert_allclose(blended.u, newton.u, atol=1e-8)
 
 
 def test_contact_pairs_closer_than_exclude_within_in_the_reference_are_never_active():

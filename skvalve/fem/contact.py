@@ -167,8 +167,9 @@ class ActivePairs:
 
     @property
     def touching(self) -> int:
-        """Pairs whose node has passed through its face (blended contact also lists pairs just above it)."""
-        return int(np.count_nonzero(self.gap < 0.0))
+        """Nodes that have passed through a face (the closest-triangle rule has one pair per node; blended contact
+        lists a node's pairs with every nearby triangle, some just above their face)."""
+        return int(np.unique(self.node[self.gap < 0.0]).size)
 
 
 class SurfaceContact(Term):
