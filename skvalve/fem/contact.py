@@ -289,7 +289,8 @@ class SurfaceContact(Term):
 
     def _blended_candidates(self, x, node, triangle, gap, corners) -> ActivePairs:
         r"""Every pair whose blended share is positive (:mod:`~skvalve.fem.contact_blend`), with its facing factor
-        :math:`S((-n_s\cdot n - c)/0.2)` taken at the last committed state (lagged: a node normal depends on the
+        :math:`S((-n_s\cdot n - c)/0.2)` taken at the last committed state (the current one before any commit:
+        its tangent then leaves out the factor's change) (lagged: a node normal depends on the
         node's neighbours, outside the pair; frozen within a step, the factor leaves the energy a function of the
         pair's four nodes and still switches a pair on and off smoothly as the normals turn)."""
         ok = (gap < self.above) & (gap > -self.max_penetration)
