@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from test_contact import block_contact_problem, closed_form_force, pair_central_differences
 
-from skvalve.fem import solve
+from skvalve.fem import contact_blend, solve
 from skvalve.fem.contact import SurfaceContact
 from skvalve.fem.contact_blend import free_edges, normalisation, sheets, weighted_mean_energy
 from skvalve.fem.contact_geometry import barycentric_derivatives, smooth_step
@@ -56,10 +56,17 @@ def _rough_state(problem, seed: int) -> np.ndarray:
     return u
 
 
-def test_blended_force_is_the_energy_gradient_and_the_tangent_its_derivative():
+def test_blended_force_is_the_energy_gradient_and_the_tangent_its_derivative(monkeypatch):
     """Central differences of the full term (search included: the blended energy is smooth) on states where
     pairs are partly shared, partly covered (past a free edge) and just above their face; the facing factors come
     from the committed state."""
+    totals = []
+
+    def recorded(total, *args):
+        totals.append(np.array(total))
+        return normalisation(total, *args)
+
+    monkeypatch.setattr(contact_blend, "normalisation", recorded)
     problem, contact = block_contact_problem(2, 3, 30.0, blend=BLEND)
     h = 1e-6
     seen = {"above": 0, "shared": 0}
@@ -86,6 +93,9 @@ def test_blended_force_is_the_energy_gradient_and_the_tangent_its_derivative():
             np.testing.assert_allclose((fp - fm) / (2 * h), K[:, dof], atol=1e-6 * np.abs(K).max())
         np.testing.assert_allclose(K, K.T, atol=1e-12 * np.abs(K).max())
     assert seen["above"] > 0 and seen["shared"] > 5
+    # the sheets' share totals cover all three branches of the normalisation M
+    totals = np.concatenate(totals)
+    assert np.any(totals < 0.8) and np.any((totals > 0.8) & (totals < 1.0)) and np.any(totals > 1.0)
 
 
 @pytest.mark.parametrize(("n_top", "rel"), [(2, 1e-6), (3, 1e-2)])
