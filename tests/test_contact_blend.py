@@ -126,7 +126,6 @@ def _crease_forces(blend: float, slides: np.ndarray) -> np.ndarray:
         v = u.copy()
         v[0::3][top] = slide
         v[2::3][top] = -0.05 - 0.3 * (0.5 - np.abs(X[0, top] + slide - 0.5).clip(max=0.5))  # the valley, 0.05 deep
-        contact.last_pairs = None
         forces.append(contact.assemble(v, 1.0, False, None).internal[: 3 * X.shape[1]].reshape(-1, 3)[top].sum(0))
     return np.array(forces)
 

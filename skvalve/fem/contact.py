@@ -355,7 +355,8 @@ class SurfaceContact(Term):
 
     # ---------------------------------------------------------------- assembly
     def assemble(self, u: np.ndarray, t: float, tangent: bool, step: int | None) -> Contribution:
-        self._assembled_u = np.array(u, dtype=float)
+        if self.blend > 0.0:  # the state whose normals give the facing factors once committed
+            self._assembled_u = np.array(u, dtype=float)
         pairs = self.active_pairs(u)
         return self.assemble_pairs(u, t, pairs, tangent)
 
@@ -372,13 +373,14 @@ class SurfaceContact(Term):
         tri = self.surface.triangles[pairs.triangle]
         corners = (x[pairs.node], x[tri[:, 0]], x[tri[:, 1]], x[tri[:, 2]])
         g, grad, hess = gap_derivatives(*corners, tangent)
-        pressure, stiffness = self.pressure_law(-g, float(self.penalty(t)))
         dofs = (3 * np.column_stack([pairs.node, tri])[:, :, None] + np.arange(3)).reshape(-1, 12)
+        penalty = float(self.penalty(t))
         if self.blend > 0.0:
-            return self._assemble_blended(pairs, corners, (g, grad, hess), (pressure, stiffness), dofs, t, tangent)
+            return self._assemble_blended(pairs, corners, (g, grad, hess), penalty, dofs, tangent)
+        pressure, stiffness = self.pressure_law(-g, penalty)
         area = self.area[pairs.node]
         forces = -(area * pressure)[:, None] * grad
-        self.last_energy = float(np.sum(area * self.penalty_energy(-g, float(self.penalty(t)))))
+        self.last_energy = float(np.sum(area * self.penalty_energy(-g, penalty)))
         np.add.at(internal, dofs.ravel(), forces.ravel())
         self.last_force = internal[: self.space.n_u].copy()
         matrix = None
@@ -390,19 +392,19 @@ class SurfaceContact(Term):
             matrix = sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(n_dofs, n_dofs))
         return Contribution(internal=internal, matrix=matrix)
 
-    def _assemble_blended(self, pairs, corners, gap, law, dofs, t, tangent) -> Contribution:
-        """Blended contact (:mod:`skvalve.fem.contact_blend`) of the candidate pairs."""
+    def _assemble_blended(self, pairs, corners, gap, penalty: float, dofs, tangent) -> Contribution:
+        """Blended contact (:mod:`skvalve.fem.contact_blend`) of the candidate pairs (some above their face)."""
         g, g_grad, g_hess = gap
-        pressure, stiffness = law
         overlap = np.maximum(-g, 0.0)
-        pressure, stiffness = np.where(g < 0.0, pressure, 0.0), np.where(g < 0.0, stiffness, 0.0)
-        psi = self.penalty_energy(overlap, float(self.penalty(t)))
+        pressure, stiffness = self.pressure_law(overlap, penalty)
+        stiffness = np.where(g < 0.0, stiffness, 0.0)  # an unrounded law has stiffness at zero overlap
+        psi = self.penalty_energy(overlap, penalty)
         psi_grad = -pressure[:, None] * g_grad
         psi_hess = None
         if tangent:
             psi_hess = stiffness[:, None, None] * g_grad[:, :, None] * g_grad[:, None, :] \
                 - pressure[:, None, None] * g_hess
-        lam, lam_grad, lam_hess = barycentric_derivatives(*corners)
+        lam, lam_grad, lam_hess = barycentric_derivatives(*corners, tangent)
         phi, phi_grad, phi_hess = pair_weights(lam, lam_grad, lam_hess, g, g_grad, g_hess,
                                                self._free_edges[pairs.triangle], self.blend, self.max_penetration,
                                                self.above, tangent)

@@ -82,25 +82,21 @@ def pair_weights(lam, lam_grad, lam_hess, gap, gap_grad, gap_hess, free, band: f
     first = first * dt
     second = second * dt**2
     grads = np.concatenate([lam_grad, gap_grad[:, None], gap_grad[:, None]], axis=1)  # (n, 5, 12)
-    n, k = t.shape
-    others = np.ones((n, k))
+    k = t.shape[1]
+    # d phi / d t_i = S_i' prod_{m != i} S_m;  d2 phi / d t_i d t_j = S_i' S_j' prod_{m != i, j} S_m (S_i'' on i = j)
+    coefficient = np.empty((t.shape[0], k, k))
     for i in range(k):
         for j in range(k):
-            if i != j:
-                others[:, i] *= value[:, j]
+            rest = np.prod(value[:, [m for m in range(k) if m not in (i, j)]], axis=1)
+            coefficient[:, i, j] = rest * (second[:, i] if i == j else first[:, i] * first[:, j])
+    slope = first * np.stack([np.prod(np.delete(value, i, axis=1), axis=1) for i in range(k)], axis=1)
     phi = value.prod(axis=1)
-    grad = np.einsum("nk,nkj->nj", others * first, grads)
+    grad = np.einsum("nk,nkj->nj", slope, grads)
     if not hessian:
         return phi, grad, None
-    hess = np.einsum("nk,nki,nkj->nij", others * second, grads, grads)
-    hess += np.einsum("nk,nkij->nij", (others * first)[:, :3], lam_hess)
-    hess += np.einsum("n,nij->nij", (others * first)[:, 3] + (others * first)[:, 4], gap_hess)
-    for i in range(k):
-        for j in range(k):
-            if i == j:
-                continue
-            rest = np.prod(value[:, [m for m in range(k) if m not in (i, j)]], axis=1)
-            hess += np.einsum("n,ni,nj->nij", rest * first[:, i] * first[:, j], grads[:, i], grads[:, j])
+    hess = np.einsum("nkl,nki,nlj->nij", coefficient, grads, grads)
+    hess += np.einsum("nk,nkij->nij", slope[:, :3], lam_hess)
+    hess += (slope[:, 3] + slope[:, 4])[:, None, None] * gap_hess
     return phi, grad, hess
 
 

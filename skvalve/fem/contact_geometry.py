@@ -64,13 +64,14 @@ def gap_derivatives(xs: np.ndarray, x1: np.ndarray, x2: np.ndarray, x3: np.ndarr
 def barycentric(p: np.ndarray, c: np.ndarray) -> np.ndarray:
     """Barycentric coordinates (n, 3) of points ``p`` (n, 3) projected on the planes of triangles ``c`` (n, 3, 3)."""
     q = _dot_products(p - c[:, 0], c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
-    xi, eta = _ratio_values(q)
+    xi, eta, _ = _ratio_values(q)
     return np.column_stack([1.0 - xi - eta, xi, eta])
 
 
-def barycentric_derivatives(xs: np.ndarray, x1: np.ndarray, x2: np.ndarray, x3: np.ndarray):
+def barycentric_derivatives(xs: np.ndarray, x1: np.ndarray, x2: np.ndarray, x3: np.ndarray, hessian: bool = True):
     """Barycentric coordinates ``lam`` (n, 3) of the projection of ``xs`` on the triangle's plane, their gradients
-    (n, 3, 12) and Hessians (n, 3, 12, 12) w.r.t. ``[xs, x1, x2, x3]`` (module docstring)."""
+    (n, 3, 12) and Hessians (n, 3, 12, 12, ``None`` without ``hessian``) w.r.t. ``[xs, x1, x2, x3]`` (module
+    docstring)."""
     d, a, b = xs - x1, x2 - x1, x3 - x1
     q = _dot_products(d, a, b)
     n = q.shape[0]
@@ -80,8 +81,7 @@ def barycentric_derivatives(xs: np.ndarray, x1: np.ndarray, x2: np.ndarray, x3: 
     N1_q = np.column_stack([zero, q[:, 3], -q[:, 4], q[:, 1], -q[:, 2]])
     N2_q = np.column_stack([q[:, 4], zero, -q[:, 3], -q[:, 2], q[:, 0]])
     D_q = np.column_stack([q[:, 1], q[:, 0], -2.0 * q[:, 2], zero, zero])
-    D = q[:, 0] * q[:, 1] - q[:, 2] ** 2
-    xi, eta = _ratio_values(q)
+    xi, eta, D = _ratio_values(q)
     # dq/dz (n, 5, 9), z = (d, a, b)
     dq = np.zeros((n, 5, 9))
     dq[:, 0, 3:6] = 2.0 * a
@@ -91,17 +91,18 @@ def barycentric_derivatives(xs: np.ndarray, x1: np.ndarray, x2: np.ndarray, x3: 
     dq[:, 4, 0:3], dq[:, 4, 6:9] = b, d
     lam = np.column_stack([one - xi - eta, xi, eta])
     grad = np.zeros((n, 3, 12))
-    hess = np.zeros((n, 3, 12, 12))
+    hess = np.zeros((n, 3, 12, 12)) if hessian else None
     for k, (f, N_q, N_qq) in enumerate(((xi, N1_q, _N1_QQ), (eta, N2_q, _N2_QQ)), start=1):
         f_q = (N_q - f[:, None] * D_q) / D[:, None]
-        f_qq = (N_qq[None] - f_q[:, :, None] * D_q[:, None, :] - D_q[:, :, None] * f_q[:, None, :]
-                - f[:, None, None] * _D_QQ[None]) / D[:, None, None]
-        g9 = np.einsum("nk,nkj->nj", f_q, dq)
-        h9 = np.einsum("nki,nkl,nlj->nij", dq, f_qq, dq) + np.einsum("nk,kij->nij", f_q, _Q_HESSIAN)
-        grad[:, k] = g9 @ _CHAIN
-        hess[:, k] = _CHAIN.T @ h9 @ _CHAIN
+        grad[:, k] = np.einsum("nk,nkj->nj", f_q, dq) @ _CHAIN
+        if hessian:
+            f_qq = (N_qq[None] - f_q[:, :, None] * D_q[:, None, :] - D_q[:, :, None] * f_q[:, None, :]
+                    - f[:, None, None] * _D_QQ[None]) / D[:, None, None]
+            h9 = np.einsum("nki,nkl,nlj->nij", dq, f_qq, dq) + np.einsum("nk,kij->nij", f_q, _Q_HESSIAN)
+            hess[:, k] = _CHAIN.T @ h9 @ _CHAIN
     grad[:, 0] = -grad[:, 1] - grad[:, 2]
-    hess[:, 0] = -hess[:, 1] - hess[:, 2]
+    if hessian:
+        hess[:, 0] = -hess[:, 1] - hess[:, 2]
     return lam, grad, hess
 
 
@@ -119,9 +120,10 @@ def _dot_products(d: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.column_stack([np.einsum("ij,ij->i", u, v) for u, v in ((a, a), (b, b), (a, b), (d, a), (d, b))])
 
 
-def _ratio_values(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _ratio_values(q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """xi, eta and their denominator D from the dot products q (module docstring)."""
     D = q[:, 0] * q[:, 1] - q[:, 2] ** 2
-    return (q[:, 3] * q[:, 1] - q[:, 4] * q[:, 2]) / D, (q[:, 0] * q[:, 4] - q[:, 2] * q[:, 3]) / D
+    return (q[:, 3] * q[:, 1] - q[:, 4] * q[:, 2]) / D, (q[:, 0] * q[:, 4] - q[:, 2] * q[:, 3]) / D, D
 
 
 def _symmetric_5(entries: dict[tuple[int, int], float]) -> np.ndarray:
