@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from skvalve.fem.damping import undamped_residual
+from skvalve.fem.trust_region import TrustRegionOptions
 from skvalve.io.abaqus import read_model, trivalve_input
 from skvalve.io.files import replace_atomically
 from skvalve.papers.mathur2022.figures import write_figures
@@ -83,6 +84,16 @@ PTC_FLAGS = {
     "stall_steps": (int, "give up when the held residual has not halved in this many steps (0: never)"),
 }
 
+#: flags --tr-<name> that override a TrustRegionOptions field (with --held trust-region)
+TR_FLAGS = {
+    "radius": (float, "first trust-region radius: the most a node may move in one step (mm)"),
+    "max_radius": (float, "largest trust-region radius (mm)"),
+    "max_strain_increment": (float, "largest change of an edge's or cable's tensile stretch per step"),
+    "shift": (float, "first shift of the step matrix, relative to its diagonal"),
+    "project": (int, "1: project the solid's and cables' element blocks onto positive semidefinite ones"),
+    "max_steps": (int, "the most accepted trust-region steps"),
+}
+
 
 def _add_flags(parser: argparse.ArgumentParser, table: dict, prefix: str, defaults: str) -> None:
     """``--<prefix><name>`` for each entry of a flag table (default None: the options' own value)."""
@@ -105,6 +116,9 @@ def main() -> int:
     parser.add_argument("--method", choices=("newton", "ptc"), default="ptc",
                         help="load-stepped Newton with damped steps, or pseudo-transient continuation (default)")
     _add_flags(parser, PTC_FLAGS, "ptc-", "skvalve.valve.closure.relaxation_options")
+    parser.add_argument("--held", choices=("ptc", "trust-region"), default="ptc",
+                        help="at the held load: keep relaxing by Ψtc, or switch to the energy trust region")
+    _add_flags(parser, TR_FLAGS, "tr-", "skvalve.fem.trust_region.TrustRegionOptions")
     parser.add_argument("--input", type=Path, default=None,
                         help="another TriValve input (.inp; default: the 1.0 diseased valve, $SKVALVE_TRIVALVE)")
     args = parser.parse_args()
@@ -158,8 +172,15 @@ def main() -> int:
         if ptc:  # flags set every stage's controls
             ptc_options = [(until, replace(stage, **ptc)) for until, stage in ptc_options]
         print(f"pseudo-transient continuation: {ptc_options}", flush=True)
+        held = None
+        if args.held == "trust-region":
+            tr = {name: getattr(args, "tr_" + name) for name in TR_FLAGS if getattr(args, "tr_" + name) is not None}
+            if "project" in tr:
+                tr["project"] = bool(tr["project"])
+            held = TrustRegionOptions(rtol=options.rtol, atol=options.atol, **tr)
+            print(f"held load: {held}", flush=True)
         run = relax_closure(setup, options.end, ptc_options, callbacks=[LastState(args.out)], progress=False,
-                            verbose=args.verbose, u0=u0, t0=t0)
+                            verbose=args.verbose, u0=u0, t0=t0, held=held)
     else:
         run = run_closure(setup, options, callbacks=[LastState(args.out)], progress=False, verbose=args.verbose,
                           u0=u0, t0=t0)

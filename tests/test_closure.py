@@ -14,6 +14,7 @@ from skvalve.fem.contact import ContactSurface, SurfaceContact
 from skvalve.fem.damping import DampingSchedule, ViscousDamping
 from skvalve.fem.hyperelastic import HyperelasticTerm
 from skvalve.fem.ptc import PseudoTransientOptions
+from skvalve.fem.trust_region import TrustRegionOptions, TrustRegionStep
 from skvalve.io.abaqus import read_model, trivalve_input
 from skvalve.materials import NeoHookean
 from skvalve.papers.mathur2022 import reproduce as reproduce_module
@@ -86,6 +87,23 @@ def test_pseudo_transient_closure_ends_where_the_load_stepped_one_does():
                                                    solver="scipy"), progress=False)
     assert blended.error is None and blended.contact_pairs[-1] == 18
     np.testing.assert_allclose(blended.u, newton.u, atol=1e-8)
+
+
+def test_a_trust_region_at_the_held_load_ends_where_the_load_stepped_closure_does():
+    """Ψtc brings the load to its end and the energy trust region relaxes there (``held``): blocks pressed into
+    blended contact reach the equilibrium that damped Newton load steps reach, with the same contact pairs."""
+    options = ClosureOptions(papillary_steps=2, pressure_steps=2, rtol=1e-9, solver="scipy")
+    newton = run_closure(_blocks_setup(0.15, blend=0.1), options, progress=False)
+    seen = []
+    relaxed = relax_closure(_blocks_setup(0.15, damped=False, blend=0.1), 1.5,
+                            PseudoTransientOptions(damping=0.5, first_step=0.05, max_load_step=0.25, rtol=1e-9,
+                                                   solver="scipy"), progress=False,
+                            held=TrustRegionOptions(rtol=1e-9, solver="scipy"), callbacks=[seen.append])
+    assert relaxed.error is None and relaxed.load_factors[-1] == 1.5
+    assert any(isinstance(event, TrustRegionStep) for event in seen)  # the held relaxation was the trust region's
+    assert relaxed.contact_pairs[-1] == newton.contact_pairs[-1] == 18
+    np.testing.assert_allclose(relaxed.u, newton.u, atol=1e-8)
+    assert relaxed.undamped_residual[1] < 1e-9
 
 
 def test_contact_pairs_closer_than_exclude_within_in_the_reference_are_never_active():

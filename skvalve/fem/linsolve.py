@@ -355,6 +355,17 @@ class LinearSolver:
             raise np.linalg.LinAlgError("sparse solve returned non-finite values (singular tangent?)")
         return x
 
+    def inertia(self) -> tuple[int, int] | None:
+        """(positive, negative) eigenvalue counts of the last symmetric factorisation (Sylvester's law of inertia
+        on PARDISO's :math:`LDL^T`), or None where the backend does not report them (non-symmetric, SuperLU)."""
+        if self._factorized_values is None:
+            raise RuntimeError("LinearSolver.inertia before factorize(values)")
+        if self.n == 0:
+            return 0, 0
+        if self.name != "pardiso" or not self.symmetric:
+            return None
+        return int(self._pardiso.iparm[21]), int(self._pardiso.iparm[22])
+
     def _release(self) -> None:
         if self._pardiso is not None:
             self._pardiso.release()

@@ -225,19 +225,26 @@ class Problem:
         self.internal_forces, self.external_forces = internal, external
         return internal - external, Tangent(contributions)
 
-    def tangent_matrix(self, tangent: Tangent) -> sp.csr_matrix:
-        """Free-dof tangent K_ff from the contributions of :meth:`assemble`."""
+    def tangent_matrix(self, tangent: Tangent, blocks=None, matrix=None) -> sp.csr_matrix:
+        """Free-dof tangent K_ff from the contributions of :meth:`assemble`.
+
+        ``blocks(term, matrices) -> matrices`` and ``matrix(term, sparse) -> sparse``, when given, replace each term's
+        element blocks and extra matrix before they are added (e.g. their symmetric parts, or blocks projected onto
+        positive semidefinite ones: :func:`skvalve.fem.trust_region.step_matrix`).
+        """
         pat = self.pattern
         data = np.zeros(pat.indices.size)
         extra = None
-        for positions, contribution in zip(pat.positions, tangent.contributions, strict=True):
+        for term, positions, contribution in zip(self.terms, pat.positions, tangent.contributions, strict=True):
             for pos, block in zip(positions, contribution.blocks, strict=True):
                 if block.matrices is None:
                     raise ValueError("tangent_matrix needs contributions assembled with tangent=True")
                 if pos.size:
-                    scatter_add(np.ascontiguousarray(block.matrices), pos, data)
+                    matrices = block.matrices if blocks is None else blocks(term, block.matrices)
+                    scatter_add(np.ascontiguousarray(matrices), pos, data)
             if contribution.matrix is not None:
-                part = sp.csr_matrix(contribution.matrix)[pat.free][:, pat.free]
+                whole = contribution.matrix if matrix is None else matrix(term, contribution.matrix)
+                part = sp.csr_matrix(whole)[pat.free][:, pat.free]
                 extra = part if extra is None else extra + part
         nfree = pat.free.size
         K = sp.csr_matrix((data, pat.indices, pat.indptr), shape=(nfree, nfree))

@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 import resource
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +34,7 @@ from ..fem.newton import StepEvent, solve
 from ..fem.problem import Problem
 from ..fem.ptc import PseudoTransientOptions, pseudo_transient
 from ..fem.truss import Truss
+from ..fem.trust_region import TrustRegionOptions, trust_region
 from ..io.abaqus import AbaqusModel, read_model, trivalve_input
 from ..io.files import replace_atomically
 from .model import ValveModel, valve_model
@@ -332,13 +333,16 @@ class EveryLoadFactor:
 def relax_closure(setup: ClosureSetup, end: float,
                   options: PseudoTransientOptions | list[tuple[float, PseudoTransientOptions]] | None = None,
                   callbacks=(), progress: bool = True, verbose: bool = False, u0: np.ndarray | None = None,
-                  t0: float = 0.0) -> ClosureRun:
+                  t0: float = 0.0, held: TrustRegionOptions | None = None) -> ClosureRun:
     """The closure by pseudo-transient continuation (:func:`~skvalve.fem.ptc.pseudo_transient`): one damped,
     linearised step per pseudo-time step, no equilibrium asked for on the way, relaxed at ``end`` to the undamped
     equilibrium. ``setup`` must have no damping term (``ClosureOptions(damping=0)``): the damping is the
     solver's, with :func:`damping_weights`. ``options``: one set, or stages ``(until, options)`` run one after the
-    other (:func:`relaxation_options`). Never raises for a failed run: the error and the kept state are recorded (the
-    last accepted one; after giving up at the held load, the held state with the smallest residual).
+    other (:func:`relaxation_options`). ``held``: relax at the held load with the energy trust region
+    (:func:`~skvalve.fem.trust_region.trust_region`) instead, from the first state Ψtc reaches there (its last
+    stage then stops as soon as the load is held, once its relative residual is below 1). Never raises for a failed
+    run: the error and the kept state are recorded (the last accepted one; after Ψtc gave up at the held load, the
+    held state with the smallest residual).
     """
     if setup.damping is not None:
         raise ValueError("relax_closure damps through the solver: build the setup with ClosureOptions(damping=0)")
@@ -366,6 +370,8 @@ def relax_closure(setup: ClosureSetup, end: float,
             stop = min(until, end)
             if stop <= t0 and until < end:
                 continue
+            if held is not None and stop >= end:  # Ψtc only brings the load to its end
+                stage = replace(stage, rtol=1.0)
             result = pseudo_transient(setup.problem, weights, stop, stage, u0=u0, t0=t0, edges=edges,
                                       rest_lengths=rest_lengths, callbacks=[record, *callbacks], progress=progress,
                                       verbose=verbose)
@@ -373,6 +379,10 @@ def relax_closure(setup: ClosureSetup, end: float,
             u0, t0 = result.u, result.load_factor
             if stop >= end:
                 break
+        if held is not None:
+            result = trust_region(setup.problem, end, u0, held, edges=edges, rest_lengths=rest_lengths,
+                                  callbacks=[record, *callbacks], progress=progress, verbose=verbose)
+            add_effort(result)
     except Exception as err:  # noqa: BLE001 - a failed closure is a result to report, with its last state
         run.error = f"{type(err).__name__}: {err}"
         result = getattr(err, "last_state", None)

@@ -1,0 +1,437 @@
+r"""Energy trust-region Newton at a held load: large steps along the soft, indefinite modes of a floppy structure.
+
+Pseudo-transient continuation (:mod:`skvalve.fem.ptc`) accepts a step when the residual does not blow up, so where a
+structure must travel through a region of negative curvature to reach its equilibrium (a valve still closing under
+its held pressure: leaflets that buckle towards coaptation) the residual rises and falls and the damping that keeps
+the linearised steps sane also keeps them short. This solver measures progress by the energy instead: for an
+(almost) conservative problem the residual is the gradient of a potential :math:`\Pi`, and the change of
+:math:`\Pi` along a step :math:`p` is the work of the residual along it,
+
+.. math::
+
+    \Delta\Pi(p) = \int_0^1 R(u + s\,p)\cdot p\,\mathrm ds
+        \approx \tfrac16\big(R(u) + 4R(u + \tfrac12 p) + R(u + p)\big)\cdot p
+
+(Simpson's rule, exact for a quartic :math:`\Pi` along the step; a follower pressure on an open surface has a
+small non-symmetric load stiffness, so there the integral is the work of the load along the straight path). Each
+step solves
+
+.. math::
+
+    (H + \alpha D)\,p = -R_f ,
+
+with :math:`H` the symmetric part of the tangent, optionally with every symmetric term's element block projected
+onto its positive semidefinite part (projected Newton: Teran, Sifakis, Irving & Fedkiw 2005), :math:`D` the
+tangent's diagonal (Marquardt's scaling; floored) and :math:`\alpha \ge 0` raised until :math:`H + \alpha D` has
+no negative eigenvalue (its inertia, from the symmetric indefinite factorisation; Nocedal & Wright 2006, Sect. 3.4).
+The step is then scaled into a trust region on the largest nodal motion :math:`\Delta` (and on the change of tensile
+stretch of watched edges), and accepted when the energy falls by at least a fraction :math:`\eta` of what the
+quadratic model :math:`m(p) = R\cdot p + \tfrac12 p^T K_s p` predicts (:math:`\rho = \Delta\Pi/m \ge \eta`). The
+ratio steers both controls: a good model (:math:`\rho > 3/4`) lowers :math:`\alpha` tenfold and widens
+:math:`\Delta`, a poor one raises :math:`\alpha`; a rejected step gives the nodes that carry its energy rise a
+local shift, or halves :math:`\Delta`. With :math:`\alpha = 0` and a tangent whose
+symmetric part is positive definite the step is Newton's with the full tangent, and the last iterations converge
+quadratically. The residual is always the undamped one: converged means :math:`\lVert R_f\rVert \le
+\max(\text{atol}, \text{rtol}\cdot f_\text{ref})` (the reactions' and loads' scale, as Newton).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+from tqdm.auto import tqdm
+
+from . import linsolve
+from .errors import ConvergenceError, NonPositiveJacobianError
+from .newton import reference_force
+from .problem import Problem, Tangent
+from .ptc import _checked_edges, _stretch_changes
+
+__all__ = ["TrustRegionOptions", "TrustRegionStep", "TrustRegionResult", "trust_region", "step_matrix",
+           "project_psd", "work_along"]
+
+logger = logging.getLogger("skvalve.fem")
+
+
+@dataclass
+class TrustRegionOptions:
+    r"""Controls of :func:`trust_region` (units of the problem).
+
+    Attributes
+    ----------
+    radius, max_radius, min_radius : float
+        The first, largest and smallest trust-region radius :math:`\Delta`: the most any node may move in one step.
+        Below ``min_radius`` the solver gives up.
+    max_strain_increment : float or None
+        Largest change of a watched edge's tensile stretch :math:`\max(\ell/L, 1)` in one step (the step is scaled
+        down to it; ``None``: off).
+    shift, min_shift, max_shift : float
+        The first shift :math:`\alpha` (relative to the tangent's diagonal), the value below which it becomes 0, and
+        the value above which the solver gives up.
+    project : bool
+        Project each element block of the symmetric terms (solids, trusses) onto its positive semidefinite part in
+        :math:`H` (the model :math:`m` keeps the true tangent).
+    eta : float
+        Accept a step when :math:`\rho = \Delta\Pi/m \ge \eta`.
+    local_shift, local_decay : float
+        A rejected step's energy change splits over the nodes (each node's share of the work integral); the fewest
+        nodes that carry 90 % of its rise get a shift of their own, at least ``local_shift`` and ten times their last
+        one (a local Levenberg-Marquardt term :math:`s_i D_i` added to :math:`H + \alpha D`; the equilibrium does not
+        depend on it), and the radius is cut only to 0.7 of the step; after each accepted step the local shifts fall
+        by ``local_decay`` (below ``min_shift``: zero). ``local_shift`` 0: off (every rejection halves the radius).
+    rtol, atol : float
+        Converged when :math:`\lVert R_f\rVert \le \max(\text{atol}, \text{rtol}\,f_\text{ref})`.
+    max_steps : int
+        The most accepted steps.
+    solver : str or None
+        Sparse backend (:func:`skvalve.fem.linsolve.solver_name`); PARDISO reports the inertia, SuperLU does not
+        (then :math:`\alpha` rises only when a step is not a descent direction of the model).
+    """
+
+    radius: float = 0.25
+    max_radius: float = 2.0
+    min_radius: float = 1e-6
+    max_strain_increment: float | None = 0.2
+    shift: float = 1e-3
+    min_shift: float = 1e-8
+    max_shift: float = 1e8
+    project: bool = True
+    eta: float = 0.1
+    local_shift: float = 0.1
+    local_decay: float = 0.5
+    rtol: float = 1e-6
+    atol: float = 0.0
+    max_steps: int = 500
+    solver: str | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("radius", "max_radius", "min_radius", "shift", "min_shift", "max_shift", "rtol"):
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
+                raise ValueError(f"TrustRegionOptions.{name} must be a positive finite number; got {value!r}")
+        if not self.min_radius <= self.radius <= self.max_radius:
+            raise ValueError("TrustRegionOptions: need min_radius <= radius <= max_radius; got "
+                             f"{self.min_radius!r}, {self.radius!r}, {self.max_radius!r}")
+        if not self.min_shift < self.max_shift:
+            raise ValueError(f"TrustRegionOptions: need min_shift < max_shift; got {self.min_shift!r}, "
+                             f"{self.max_shift!r}")
+        if not (math.isfinite(self.local_shift) and self.local_shift >= 0.0) or not 0.0 < self.local_decay <= 1.0:
+            raise ValueError("TrustRegionOptions: need local_shift >= 0 and 0 < local_decay <= 1; got "
+                             f"{self.local_shift!r}, {self.local_decay!r}")
+        if not 0.0 < self.eta < 0.25:
+            raise ValueError(f"TrustRegionOptions.eta must lie in (0, 0.25); got {self.eta!r}")
+        if self.max_strain_increment is not None and not (math.isfinite(self.max_strain_increment)
+                                                          and self.max_strain_increment > 0):
+            raise ValueError("TrustRegionOptions.max_strain_increment must be None or positive; "
+                             f"got {self.max_strain_increment!r}")
+        if not (math.isfinite(self.atol) and self.atol >= 0):
+            raise ValueError(f"TrustRegionOptions.atol must be finite and >= 0; got {self.atol!r}")
+        if not (isinstance(self.max_steps, int) and self.max_steps > 0):
+            raise ValueError(f"TrustRegionOptions.max_steps must be a positive integer; got {self.max_steps!r}")
+
+
+@dataclass
+class TrustRegionStep:
+    """What a callback receives after each accepted step (the fields a pseudo-transient callback reads, too)."""
+
+    problem: Problem
+    step: int
+    load_factor: float
+    u: np.ndarray
+    residual_norm: float
+    relative_residual: float
+    energy_change: float
+    ratio: float
+    shift: float
+    radius: float
+
+
+@dataclass
+class TrustRegionResult:
+    """The accepted steps (residual norms, energy changes, ratios, shifts, largest nodal motions) and the last state."""
+
+    u: np.ndarray
+    load_factor: float
+    residuals: list[float] = field(default_factory=list)
+    energy_changes: list[float] = field(default_factory=list)
+    ratios: list[float] = field(default_factory=list)
+    shifts: list[float] = field(default_factory=list)
+    largest_increments: list[float] = field(default_factory=list)
+    newton_steps: int = 0
+    rejected: int = 0
+    factorizations: int = 0
+    converged: bool = False
+    relative_residual: float = math.inf
+    timings: dict[str, float] = field(default_factory=lambda: {"assembly": 0.0, "solve": 0.0})
+
+
+def project_psd(matrices: np.ndarray) -> np.ndarray:
+    """Each (m, m) block's symmetric part with its negative eigenvalues set to zero (the nearest positive
+    semidefinite matrix in the Frobenius norm)."""
+    symmetric = 0.5 * (matrices + np.swapaxes(matrices, -1, -2))
+    values, vectors = np.linalg.eigh(symmetric)
+    if np.all(values >= 0.0):
+        return symmetric
+    return np.einsum("eik,ek,ejk->eij", vectors, np.maximum(values, 0.0), vectors, optimize=True)
+
+
+def step_matrix(problem: Problem, tangent: Tangent, project: bool) -> sp.csr_matrix:
+    """The symmetric part of the free-dof tangent, with the element blocks of every symmetric term projected onto
+    their positive semidefinite parts when ``project`` (non-symmetric terms, e.g. a follower pressure, and extra
+    sparse matrices, e.g. contact, enter with their symmetric parts)."""
+
+    def blocks(term, matrices):
+        if project and getattr(term, "symmetric", True):
+            return project_psd(matrices)
+        return 0.5 * (matrices + np.swapaxes(matrices, -1, -2))
+
+    def matrix(term, sparse):
+        return 0.5 * (sparse + sparse.T)
+
+    return problem.tangent_matrix(tangent, blocks=blocks, matrix=matrix).tocsr()
+
+
+def work_along(r_start: np.ndarray, r_middle: np.ndarray, r_end: np.ndarray, step: np.ndarray) -> float:
+    r"""Simpson's rule for :math:`\int_0^1 R(u + s p)\cdot p\,ds` from the residuals at s = 0, 1/2, 1 (free dofs)."""
+    return float((r_start + 4.0 * r_middle + r_end) @ step) / 6.0
+
+
+class _Attempt(Exception):
+    """A step that failed before its energy could be measured (inverted elements, a singular or non-finite solve)."""
+
+
+def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegionOptions | None = None, *,
+                 edges: np.ndarray | None = None, rest_lengths: np.ndarray | None = None,
+                 callbacks: Sequence[Callable[[TrustRegionStep], None]] = (), progress: bool = True,
+                 verbose: bool = False) -> TrustRegionResult:
+    """Relax ``problem`` at the held load factor ``t`` from ``u0`` to an equilibrium (module docstring).
+
+    ``edges``/``rest_lengths`` as in :func:`~skvalve.fem.ptc.pseudo_transient`. Returns a :class:`TrustRegionResult`
+    with ``converged`` set; raises :class:`~skvalve.fem.errors.ConvergenceError` (``error.last_state``: the result up
+    to the last accepted step) when the radius falls below ``min_radius``, the shift passes ``max_shift`` or
+    ``max_steps`` pass.
+    """
+    opts = options or TrustRegionOptions()
+    if not math.isfinite(t):
+        raise ValueError(f"the held load factor must be finite; got {t!r}")
+    solver_name = linsolve.solver_name(opts.solver)
+    n = problem.space.n_dofs
+    u = np.array(u0, dtype=float).ravel()
+    if u.shape != (n,) or not np.all(np.isfinite(u)):
+        raise ValueError(f"u0 must be {n} finite values")
+    if edges is not None:
+        edges = _checked_edges(problem, edges, rest_lengths)
+    problem.check_supports()
+    pattern = problem.pattern
+    fixed, free = pattern.fixed, pattern.free
+    _, values = problem.constrained(t)
+    u[fixed] = values
+    result = TrustRegionResult(u=u, load_factor=t)
+    solvers = (linsolve.LinearSolver(solver_name, symmetric=True), linsolve.LinearSolver(solver_name, symmetric=True),
+               linsolve.LinearSolver(solver_name, symmetric=problem.symmetric))  # shifted H, K_s's inertia, K
+    clock = time.perf_counter()
+    residual, tangent = problem.assemble(u, t, tangent=True, step=0)
+    result.timings["assembly"] += time.perf_counter() - clock
+    norm = float(np.linalg.norm(residual[free]))
+    relative = norm / reference_force(problem, residual, fixed)
+    result.relative_residual = relative
+    radius, shift = opts.radius, opts.shift
+    fallback = shift  # the last positive shift: where to start again when a Newton step is not possible
+    local = np.zeros(n)  # local shifts s_i (relative to D)
+    space = problem.space
+    bar = tqdm(total=opts.max_steps, disable=not progress, desc="trust region", leave=False)
+    try:
+        while True:
+            if relative <= opts.rtol or norm <= opts.atol:
+                result.converged = True
+                break
+            if len(result.residuals) >= opts.max_steps:
+                raise _give_up(result, f"{opts.max_steps} steps without converging")
+            if radius < opts.min_radius:
+                raise _give_up(result, f"the trust region shrank to {radius:.2e} (below min_radius)")
+            step = len(result.residuals) + 1
+            clock = time.perf_counter()
+            K = problem.tangent_matrix(tangent)
+            symmetric_K = (0.5 * (K + K.T)).tocsr()
+            H = step_matrix(problem, tangent, opts.project) if opts.project else symmetric_K
+            scale = np.abs(H.diagonal())
+            floor = float(np.median(scale[scale > 0.0])) * 1e-3 if np.any(scale > 0.0) else 1.0
+            diagonal = np.maximum(scale, floor)
+            D = sp.diags(diagonal, format="csr")
+            if np.any(local[free] > 0.0):
+                H = (H + sp.diags(local[free] * diagonal, format="csr")).tocsr()
+            result.timings["assembly"] += time.perf_counter() - clock
+            clock = time.perf_counter()
+            direction, shift, newton = _direction(solvers, symmetric_K, K, H, D, -residual[free], shift, fallback,
+                                                  not np.any(local > 0.0), opts, result)
+            if shift > 0.0:
+                fallback = shift
+            result.timings["solve"] += time.perf_counter() - clock
+            if direction is None:
+                raise _give_up(result, f"no shift up to max_shift {opts.max_shift:g} gives a positive definite step "
+                                       "matrix or a descent direction")
+            p = np.zeros(n)
+            p[free] = direction
+            moves = np.linalg.norm(p[: space.n_u].reshape(-1, space.dim), axis=1)
+            largest = float(moves.max(initial=0.0))
+            factor = min(1.0, radius / largest) if largest > 0.0 else 1.0
+            if edges is not None and opts.max_strain_increment is not None and edges[0].size:
+                change = float(np.max(_stretch_changes(edges[2], u, u + factor * p, edges[0], edges[1])))
+                if change > opts.max_strain_increment:
+                    factor *= opts.max_strain_increment / change
+            p *= factor
+            largest *= factor
+            r_free, p_free = residual[free], p[free]
+            predicted = float(r_free @ p_free + 0.5 * p_free @ (symmetric_K @ p_free))
+            clock = time.perf_counter()
+            try:
+                middle, _ = _residual(problem, u + 0.5 * p, t, step)
+                trial_residual, trial_tangent = problem.assemble(u + p, t, tangent=True, step=step)
+                if not np.all(np.isfinite(trial_residual)):
+                    raise _Attempt("the residual is not finite")
+            except (NonPositiveJacobianError, _Attempt) as err:
+                result.timings["assembly"] += time.perf_counter() - clock
+                problem.rewind()
+                result.rejected += 1
+                radius = 0.5 * largest
+                logger.info("trust-region step %d rejected: %s", step, err)
+                if verbose:
+                    print(f"  rejected step {step}: {err}; radius {radius:.3g}", flush=True)
+                continue
+            result.timings["assembly"] += time.perf_counter() - clock
+            nodal_work = _nodal_work(residual, middle, trial_residual, p, free, space)
+            work = float(nodal_work.sum())
+            ratio = work / predicted if predicted < 0.0 else -math.inf
+            if not (work < 0.0 and ratio >= opts.eta):
+                problem.rewind()
+                result.rejected += 1
+                carriers = _carriers(nodal_work) if opts.local_shift > 0.0 else np.zeros(0, dtype=int)
+                if carriers.size and carriers.size <= 0.1 * nodal_work.size:
+                    dofs = space.displacement_dofs(carriers).ravel()
+                    local[dofs] = np.maximum(10.0 * local[dofs], opts.local_shift)
+                    radius = 0.7 * largest
+                else:
+                    radius = 0.5 * largest
+                    shift = min(max(4.0 * shift, opts.min_shift), opts.max_shift)
+                logger.info("trust-region step %d rejected: energy change %.3e, ratio %.3g", step, work, ratio)
+                if verbose:
+                    print(f"  rejected step {step}: dPi={work:.3e} m={predicted:.3e} rho={ratio:.3g} max|du|="
+                          f"{largest:.3g}; radius {radius:.3g} shift {shift:.3g}; {carriers.size} nodes carry 90 % "
+                          f"of the rise{f' (first {carriers[:5].tolist()})' if carriers.size else ''}", flush=True)
+                continue
+            problem.commit()
+            local *= opts.local_decay
+            local[local < opts.min_shift] = 0.0
+            u, residual, tangent = u + p, trial_residual, trial_tangent
+            norm = float(np.linalg.norm(residual[free]))
+            relative = norm / reference_force(problem, residual, fixed)
+            result.u, result.relative_residual = u, relative
+            result.newton_steps += newton
+            for name, value in (("residuals", norm), ("energy_changes", work), ("ratios", ratio),
+                                ("shifts", 0.0 if newton else shift), ("largest_increments", largest)):
+                getattr(result, name).append(value)
+            if verbose:
+                print(f"step {step} |R|={norm:.3e} rel={relative:.3e} dPi={work:.3e} rho={ratio:.3f} "
+                      f"shift={0.0 if newton else shift:.3g} max|du|={largest:.3g} radius={radius:.3g}"
+                      f"{' newton' if newton else ''}", flush=True)
+            if ratio > 0.75:
+                shift = 0.0 if shift / 10.0 < opts.min_shift else shift / 10.0
+                if factor < 1.0:
+                    radius = min(2.0 * radius, opts.max_radius)
+            elif ratio < 0.25:
+                shift = min(max(2.0 * shift, opts.min_shift), opts.max_shift)
+                radius = max(0.5 * largest, opts.min_radius)
+            if not bar.disable:
+                bar.update(1)
+                bar.set_postfix(rel=f"{relative:.1e}", shift=f"{shift:.1e}", radius=f"{radius:.2g}")
+            event = TrustRegionStep(problem, step, t, u, norm, relative, work, ratio, shift, radius)
+            for callback in callbacks:
+                callback(event)
+    finally:
+        bar.close()
+    return result
+
+
+def _nodal_work(r_start, r_middle, r_end, step, free, space) -> np.ndarray:
+    """Each node's share of :func:`work_along` (free dofs only; the shares sum to the work)."""
+    per_dof = np.zeros_like(step)
+    per_dof[free] = (r_start[free] + 4.0 * r_middle[free] + r_end[free]) * step[free] / 6.0
+    return per_dof[: space.n_u].reshape(-1, space.dim).sum(axis=1)
+
+
+def _carriers(nodal_work: np.ndarray, share: float = 0.9) -> np.ndarray:
+    """The fewest nodes whose work rises carry ``share`` of the total rise (empty when nothing rose)."""
+    rising = np.maximum(nodal_work, 0.0)
+    total = rising.sum()
+    if total <= 0.0:
+        return np.zeros(0, dtype=int)
+    order = np.argsort(rising)[::-1]
+    count = int(np.searchsorted(np.cumsum(rising[order]), share * total)) + 1
+    return np.sort(order[: min(count, order.size)])
+
+
+def _residual(problem: Problem, u: np.ndarray, t: float, step: int) -> tuple[np.ndarray, Tangent]:
+    residual, tangent = problem.assemble(u, t, tangent=False, step=step)
+    if not np.all(np.isfinite(residual)):
+        raise _Attempt("the residual is not finite")
+    return residual, tangent
+
+
+def _direction(solvers, symmetric_K, K, H, D, rhs, shift: float, fallback: float, newton_allowed: bool,
+               opts: TrustRegionOptions, result: TrustRegionResult):
+    """The step direction, the shift it took and whether it is Newton's.
+
+    Newton's with the full tangent when the shift is 0, no local shift is on (``newton_allowed``) and the tangent's
+    symmetric part is positive definite; else :math:`(H + \\alpha D)^{-1}` rhs with :math:`\\alpha` (from ``fallback``
+    after a Newton step was not possible) raised x8 until the matrix has no negative eigenvalue and the direction is
+    one of descent. (None, shift, False) when no shift up to ``max_shift`` gives one.
+    """
+    symmetric, definite, general = solvers
+    if shift == 0.0 and newton_allowed:
+        _factorize(definite, symmetric_K, result)
+        inertia = definite.inertia()
+        if inertia is not None and inertia[1] == 0:
+            try:
+                _factorize(general, K, result)
+                x = general.solve(rhs)
+                if float(rhs @ x) > 0.0:
+                    return x, 0.0, True
+            except np.linalg.LinAlgError:
+                pass
+    if shift == 0.0:
+        shift = max(opts.min_shift, 0.25 * fallback)
+    while shift <= opts.max_shift:
+        A = (H + shift * D).tocsr()
+        try:
+            _factorize(symmetric, A, result)
+            inertia = symmetric.inertia()
+            if inertia is None or inertia[1] == 0:
+                x = symmetric.solve(rhs)
+                if float(rhs @ x) > 0.0 and float(x @ (A @ x)) > 0.0:
+                    return x, shift, False
+        except np.linalg.LinAlgError:
+            pass
+        shift *= 8.0
+    return None, shift, False
+
+
+def _factorize(solver: linsolve.LinearSolver, matrix: sp.csr_matrix, result: TrustRegionResult) -> None:
+    csr = sp.csr_matrix(matrix)
+    csr.sort_indices()
+    solver.analyse((csr.indptr, csr.indices))
+    solver.factorize(csr.data)
+    result.factorizations += 1
+
+
+def _give_up(result: TrustRegionResult, reason: str) -> ConvergenceError:
+    error = ConvergenceError(f"trust-region relaxation stopped after {len(result.residuals)} accepted steps "
+                             f"({result.rejected} rejected): {reason}; relative residual "
+                             f"{result.relative_residual:.2e}")
+    error.last_state = result
+    return error

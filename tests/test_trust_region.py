@@ -1,0 +1,157 @@
+"""Energy trust-region Newton (:mod:`skvalve.fem.trust_region`): it ends where Newton and closed forms end, crosses a
+region of negative curvature to the stable equilibrium, measures the energy change exactly where it can, and fails
+clearly."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import skfem
+from scipy.optimize import brentq
+
+from skvalve.fem import NodalForce, Problem, Solid, Space, solve
+from skvalve.fem.errors import ConvergenceError
+from skvalve.fem.linsolve import LinearSolver, available_solvers
+from skvalve.fem.truss import Truss
+from skvalve.fem.trust_region import TrustRegionOptions, project_psd, step_matrix, trust_region, work_along
+from skvalve.materials import NeoHookean
+from skvalve.materials.uniaxial import OgdenUniaxial
+
+
+def _sheared_block() -> Solid:
+    solid = Solid(skfem.MeshHex().refined(2), NeoHookean(1.0, 10.0))
+    solid.add_dirichlet(lambda X: X[0] == 0.0, 0.0)
+    solid.add_dirichlet(lambda X: X[0] == 1.0, np.array([0.0, 0.0, 0.5]))
+    return solid
+
+
+def test_ends_where_load_stepped_newton_ends_and_finishes_with_newton_steps():
+    """Path independence: from the reference at the full load (no load steps), the trust region must reach the
+    state of 10 converged Newton load steps, every accepted step lowering the energy, the last steps Newton's."""
+    newton = solve(_sheared_block(), 10, progress=False, rtol=1e-11)
+    block = _sheared_block()
+    seen = []
+    result = trust_region(block, 1.0, np.zeros(block.space.n_dofs), TrustRegionOptions(rtol=1e-11, radius=0.1),
+                          progress=False, callbacks=[seen.append])
+    assert result.converged
+    assert np.abs(result.u - newton.u()).max() <= 1e-9 * np.abs(newton.u()).max()
+    residual, _ = block.assemble(result.u, 1.0, tangent=False)
+    assert np.linalg.norm(residual[block.pattern.free]) <= 1e-11 * np.linalg.norm(residual[block.pattern.fixed])
+    assert all(change < 0.0 for change in result.energy_changes)
+    assert min(result.ratios) >= 0.1 and result.newton_steps >= 1 and result.shifts[-1] == 0.0
+    assert result.largest_increments[0] == pytest.approx(0.1)  # the first step was held to the radius
+    assert [event.step for event in seen] == list(range(1, len(result.residuals) + 1))
+
+
+def _arch(load: float):
+    """A shallow two-bar (von Mises) arch of incompressible Ogden bars: supports at x = 0 and 2, apex at (1, h), only
+    the apex's vertical dof free, a dead load ``load`` pushing it down. Returns problem, law, h, apex y dof."""
+    mesh = skfem.MeshHex().scaled([2.0, 0.4, 1.0]).refined(1)  # vertices at y = 0, 0.2, 0.4
+    space = Space(mesh)
+    X = space.dof_coordinates
+    def node(x, y, z):
+        return int(np.flatnonzero(np.isclose(X[0], x) & np.isclose(X[1], y) & np.isclose(X[2], z))[0])
+    left, right, apex = node(0, 0, 0), node(2, 0, 0), node(1, 0.2, 0)
+    law = OgdenUniaxial((1.0,), (2.0,))
+    problem = Problem(space, [Truss(space, [[left, apex], [right, apex]], 0.1, law)])
+    nodes = np.arange(space.n_scalar)
+    problem.add_dirichlet(nodes=nodes, value=0.0, components=[0, 2])
+    problem.add_dirichlet(nodes=nodes[nodes != apex], value=0.0, components=[1])
+    problem.add_term(NodalForce(space, np.array([apex]), np.array([0.0, -load, 0.0]), ramp=False))
+    return problem, law, 0.2, 3 * apex + 1
+
+
+def _arch_force(law, y, h=0.2, a=1.0, area=0.1):
+    """The bars' internal force on the apex's vertical dof at height y, the derivative of their energy
+    2 A L0 W(lambda(y)) (closed form): 2 A P(lambda) y / L; a compressed arch (P < 0, y > 0) pushes the apex up."""
+    length = np.hypot(a, y)
+    stretch = length / np.hypot(a, h)
+    return 2.0 * area * law.nominal_stress(np.array([stretch]))[0][0] * y / length
+
+
+def test_snaps_through_a_limit_point_to_the_stable_equilibrium():
+    """Past the arch's limit load the only equilibria have the apex below the supports: the tangent turns negative on
+    the way (the region between the limit points), the inertia test shifts it, and the run ends on the closed-form
+    root with a positive stiffness."""
+    heights = np.linspace(0.0, 0.2, 401)
+    upward = np.array([-_arch_force(OgdenUniaxial((1.0,), (2.0,)), y) for y in heights])  # compression holds it up
+    limit = upward.max()
+    load = 1.5 * limit
+    problem, law, h, dof = _arch(load)
+    options = TrustRegionOptions(rtol=1e-12, radius=0.05, max_radius=0.5, project=False)
+    heights_seen = []
+    result = trust_region(problem, 1.0, np.zeros(problem.space.n_dofs), options, progress=False,
+                          callbacks=[lambda event: heights_seen.append(h + event.u[dof])])
+    assert result.converged
+    y = h + result.u[dof]
+    root = brentq(lambda yy: _arch_force(OgdenUniaxial((1.0,), (2.0,)), yy) + load, -2.0, -1e-9, xtol=1e-15)
+    assert y == pytest.approx(root, rel=1e-9)
+    stiffness = (_arch_force(law, y + 1e-6) - _arch_force(law, y - 1e-6)) / 2e-6
+    assert stiffness > 0.0  # a stable equilibrium
+    # accepted states inside the unstable branch (negative stiffness): the region was crossed, not jumped
+    assert sum(_arch_force(law, yy + 1e-6) < _arch_force(law, yy - 1e-6) for yy in heights_seen) >= 2
+    assert all(change < 0.0 for change in result.energy_changes)
+
+
+def test_work_along_a_step_is_exact_for_a_quartic_energy():
+    """Simpson's rule integrates the residual's work exactly when the energy is a quartic polynomial along the step."""
+    rng = np.random.default_rng(4)
+    a, b, c = rng.normal(size=(3, 5))
+
+    def energy(x):
+        return float(a @ x + (b @ x) ** 2 + (c @ x) ** 4 / 4.0)
+
+    def gradient(x):
+        return a + 2.0 * (b @ x) * b + (c @ x) ** 3 * c
+
+    u, p = rng.normal(size=(2, 5))
+    work = work_along(gradient(u), gradient(u + 0.5 * p), gradient(u + p), p)
+    assert work == pytest.approx(energy(u + p) - energy(u), rel=1e-12)
+
+
+def test_projected_blocks_are_the_nearest_semidefinite_ones():
+    rng = np.random.default_rng(5)
+    blocks = rng.normal(size=(20, 6, 6))
+    projected = project_psd(blocks)
+    symmetric = 0.5 * (blocks + np.swapaxes(blocks, 1, 2))
+    assert np.allclose(projected, np.swapaxes(projected, 1, 2))
+    assert np.linalg.eigvalsh(projected).min() >= -1e-12
+    values, vectors = np.linalg.eigh(symmetric)
+    # the difference is exactly the negative spectral part
+    negative = np.einsum("eik,ek,ejk->eij", vectors, np.minimum(values, 0.0), vectors)
+    np.testing.assert_allclose(symmetric - projected, negative, atol=1e-12)
+    definite = np.einsum("eij,ekj->eik", blocks, blocks)
+    np.testing.assert_allclose(project_psd(definite), definite, atol=1e-12)
+    # on a solid in compression, the step matrix is the projected blocks assembled: positive semidefinite
+    block = _sheared_block()
+    u = np.zeros(block.space.n_dofs)
+    u[block.pattern.fixed] = block.constrained(1.0)[1]
+    _, tangent = block.assemble(u, 1.0)
+    H = step_matrix(block, tangent, project=True).toarray()
+    assert np.allclose(H, H.T) and np.linalg.eigvalsh(H).min() >= -1e-10 * np.abs(H).max()
+
+
+@pytest.mark.skipif("pardiso" not in available_solvers(), reason="PARDISO reports the inertia")
+def test_the_symmetric_factorisation_reports_the_inertia():
+    values = np.array([3.0, -1.0, 2.0, -4.0, 5.0, 1e-3])
+    rng = np.random.default_rng(6)
+    Q, _ = np.linalg.qr(rng.normal(size=(6, 6)))
+    A = sp.csr_matrix(Q @ np.diag(values) @ Q.T)
+    solver = LinearSolver("pardiso", symmetric=True)
+    solver.analyse(A).factorize(A)
+    assert solver.inertia() == (4, 2)
+    assert LinearSolver("scipy", symmetric=True).analyse(A).factorize(A).inertia() is None
+
+
+def test_bad_options_and_giving_up_keep_the_last_state():
+    for bad in ({"radius": 0.0}, {"eta": 0.5}, {"min_radius": 1.0, "radius": 0.5}, {"max_strain_increment": -1.0},
+                {"max_steps": 0}, {"atol": float("nan")}, {"min_shift": 10.0, "max_shift": 1.0}):
+        with pytest.raises(ValueError, match="TrustRegionOptions"):
+            TrustRegionOptions(**bad)
+    block = _sheared_block()
+    with pytest.raises(ValueError, match="finite"):
+        trust_region(block, 1.0, np.full(block.space.n_dofs, np.nan), progress=False)
+    with pytest.raises(ConvergenceError, match="2 steps without converging") as info:
+        trust_region(block, 1.0, np.zeros(block.space.n_dofs), TrustRegionOptions(max_steps=2, radius=0.01),
+                     progress=False)
+    state = info.value.last_state
+    assert len(state.residuals) == 2 and np.isfinite(state.u).all() and state.relative_residual < 1.0
