@@ -12,7 +12,14 @@ from skvalve.fem import NodalForce, Problem, Solid, Space, solve
 from skvalve.fem.errors import ConvergenceError
 from skvalve.fem.linsolve import LinearSolver, available_solvers
 from skvalve.fem.truss import Truss
-from skvalve.fem.trust_region import TrustRegionOptions, project_psd, step_matrix, trust_region, work_along
+from skvalve.fem.trust_region import (
+    TrustRegionOptions,
+    project_psd,
+    project_sparse_psd,
+    step_matrix,
+    trust_region,
+    work_along,
+)
 from skvalve.materials import NeoHookean
 from skvalve.materials.uniaxial import OgdenUniaxial
 
@@ -121,6 +128,16 @@ def test_projected_blocks_are_the_nearest_semidefinite_ones():
     np.testing.assert_allclose(symmetric - projected, negative, atol=1e-12)
     definite = np.einsum("eij,ekj->eik", blocks, blocks)
     np.testing.assert_allclose(project_psd(definite), definite, atol=1e-12)
+    # a sparse matrix (contact's): each connected block projected on its own; the pattern's other entries stay zero
+    a, b = rng.normal(size=(2, 3, 3))
+    dense = np.zeros((8, 8))
+    dense[np.ix_([0, 2, 5], [0, 2, 5])] = a + a.T
+    dense[np.ix_([1, 6, 7], [1, 6, 7])] = b @ b.T  # already semidefinite: unchanged
+    projected_sparse = project_sparse_psd(sp.csr_matrix(dense)).toarray()
+    expected = np.zeros((8, 8))
+    expected[np.ix_([0, 2, 5], [0, 2, 5])] = project_psd((a + a.T)[None])[0]
+    expected[np.ix_([1, 6, 7], [1, 6, 7])] = b @ b.T
+    np.testing.assert_allclose(projected_sparse, expected, atol=1e-12)
     # on a solid in compression, the step matrix is the projected blocks assembled: positive semidefinite
     block = _sheared_block()
     u = np.zeros(block.space.n_dofs)

@@ -45,6 +45,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 from tqdm.auto import tqdm
 
 from . import linsolve
@@ -54,7 +55,7 @@ from .problem import Problem, Tangent
 from .ptc import _checked_edges, _stretch_changes
 
 __all__ = ["TrustRegionOptions", "TrustRegionStep", "TrustRegionResult", "trust_region", "step_matrix",
-           "project_psd", "work_along"]
+           "project_psd", "project_sparse_psd", "work_along"]
 
 logger = logging.getLogger("skvalve.fem")
 
@@ -75,8 +76,9 @@ class TrustRegionOptions:
         The first shift :math:`\alpha` (relative to the tangent's diagonal), the value below which it becomes 0, and
         the value above which the solver gives up.
     project : bool
-        Project each element block of the symmetric terms (solids, trusses) onto its positive semidefinite part in
-        :math:`H` (the model :math:`m` keeps the true tangent).
+        Project each element block of the symmetric terms (solids, trusses), and each connected block of an extra
+        sparse matrix (contact), onto its positive semidefinite part in :math:`H` (the model :math:`m` keeps the
+        true tangent).
     eta : float
         Accept a step when :math:`\rho = \Delta\Pi/m \ge \eta`.
     local_shift, local_decay : float
@@ -181,10 +183,40 @@ def project_psd(matrices: np.ndarray) -> np.ndarray:
     return np.einsum("eik,ek,ejk->eij", vectors, np.maximum(values, 0.0), vectors, optimize=True)
 
 
+def project_sparse_psd(matrix: sp.spmatrix, largest: int = 4000) -> sp.csr_matrix:
+    """The symmetric part of a sparse matrix with each connected block (the components of its pattern's graph, e.g.
+    one patch of contact pairs) projected onto its positive semidefinite part; a block of more than ``largest`` rows
+    keeps its symmetric part (a dense eigendecomposition would cost too much)."""
+    symmetric = (0.5 * (matrix + matrix.T)).tocsr()
+    symmetric.eliminate_zeros()
+    rows = np.flatnonzero(np.diff(symmetric.indptr))
+    if rows.size == 0:
+        return symmetric
+    inner = symmetric[rows][:, rows]
+    count, labels = connected_components(inner, directed=False)
+    out_rows, out_cols, out_values = [], [], []
+    order = np.argsort(labels, kind="stable")
+    bounds = np.concatenate([[0], np.cumsum(np.bincount(labels, minlength=count))])
+    for k in range(count):
+        local = order[bounds[k]: bounds[k + 1]]
+        block = inner[local][:, local].toarray()
+        if local.size <= largest:
+            values, vectors = np.linalg.eigh(block)
+            if values.min() < 0.0:
+                block = (vectors * np.maximum(values, 0.0)) @ vectors.T
+        r, c = np.meshgrid(rows[local], rows[local], indexing="ij")
+        out_rows.append(r.ravel())
+        out_cols.append(c.ravel())
+        out_values.append(block.ravel())
+    return sp.csr_matrix((np.concatenate(out_values), (np.concatenate(out_rows), np.concatenate(out_cols))),
+                         shape=matrix.shape)
+
+
 def step_matrix(problem: Problem, tangent: Tangent, project: bool) -> sp.csr_matrix:
-    """The symmetric part of the free-dof tangent, with the element blocks of every symmetric term projected onto
-    their positive semidefinite parts when ``project`` (non-symmetric terms, e.g. a follower pressure, and extra
-    sparse matrices, e.g. contact, enter with their symmetric parts)."""
+    """The symmetric part of the free-dof tangent; when ``project``, with the element blocks of every symmetric term
+    and the extra sparse matrices (e.g. contact: :func:`project_sparse_psd`) projected onto their positive
+    semidefinite parts (a non-symmetric term's blocks, e.g. a follower pressure's load stiffness, enter with their
+    symmetric parts: their negative curvature is the structure's response to the load, which the shift handles)."""
 
     def blocks(term, matrices):
         if project and getattr(term, "symmetric", True):
@@ -192,7 +224,7 @@ def step_matrix(problem: Problem, tangent: Tangent, project: bool) -> sp.csr_mat
         return 0.5 * (matrices + np.swapaxes(matrices, -1, -2))
 
     def matrix(term, sparse):
-        return 0.5 * (sparse + sparse.T)
+        return project_sparse_psd(sparse) if project else 0.5 * (sparse + sparse.T)
 
     return problem.tangent_matrix(tangent, blocks=blocks, matrix=matrix).tocsr()
 
