@@ -26,9 +26,10 @@ tangent's diagonal (Marquardt's scaling; floored) and :math:`\alpha \ge 0` raise
 no negative eigenvalue (its inertia, from the symmetric indefinite factorisation; Nocedal & Wright 2006, Sect. 3.4).
 The step is then scaled into a trust region on the largest nodal motion :math:`\Delta` (and on the change of tensile
 stretch of watched edges), and accepted when the energy falls by at least a fraction :math:`\eta` of what the
-quadratic model :math:`m(p) = R\cdot p + \tfrac12 p^T K_s p` predicts (:math:`\rho = \Delta\Pi/m \ge \eta`). The
+quadratic model :math:`m(p) = R\cdot p + \tfrac12 p^T H p` predicts (:math:`\rho = \Delta\Pi/m \ge \eta`; for a
+Newton step :math:`H` is the true symmetric part :math:`K_s`). The
 ratio steers both controls: a good model (:math:`\rho > 3/4`) lowers :math:`\alpha` tenfold and widens
-:math:`\Delta`, a poor one raises :math:`\alpha`; a rejected step gives the nodes that carry its energy rise a
+:math:`\Delta` threefold, a poor one raises :math:`\alpha`; a rejected step gives the nodes that carry its energy rise a
 local shift, or halves :math:`\Delta`. With :math:`\alpha = 0` and a tangent whose
 symmetric part is positive definite the step is Newton's with the full tangent, and the last iterations converge
 quadratically. The residual is always the undamped one: converged means :math:`\lVert R_f\rVert \le
@@ -77,8 +78,8 @@ class TrustRegionOptions:
         the value above which the solver gives up.
     project : bool
         Project each element block of the symmetric terms (solids, trusses), and each connected block of an extra
-        sparse matrix (contact), onto its positive semidefinite part in :math:`H` (the model :math:`m` keeps the
-        true tangent).
+        sparse matrix (contact), onto its positive semidefinite part in :math:`H` (the model :math:`m` of the
+        steps that are not Newton's).
     eta : float
         Accept a step when :math:`\rho = \Delta\Pi/m \ge \eta`.
     local_shift, local_decay : float
@@ -104,7 +105,7 @@ class TrustRegionOptions:
     min_shift: float = 1e-8
     max_shift: float = 1e8
     project: bool = True
-    eta: float = 0.1
+    eta: float = 0.01
     local_shift: float = 0.1
     local_decay: float = 0.5
     rtol: float = 1e-6
@@ -296,6 +297,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             floor = float(np.median(scale[scale > 0.0])) * 1e-3 if np.any(scale > 0.0) else 1.0
             diagonal = np.maximum(scale, floor)
             D = sp.diags(diagonal, format="csr")
+            model = H  # the model's Hessian: the step matrix without the shifts (the true tangent for Newton)
             if np.any(local[free] > 0.0):
                 H = (H + sp.diags(local[free] * diagonal, format="csr")).tocsr()
             result.timings["assembly"] += time.perf_counter() - clock
@@ -320,7 +322,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             p *= factor
             largest *= factor
             r_free, p_free = residual[free], p[free]
-            predicted = float(r_free @ p_free + 0.5 * p_free @ (symmetric_K @ p_free))
+            predicted = float(r_free @ p_free + 0.5 * p_free @ ((symmetric_K if newton else model) @ p_free))
             clock = time.perf_counter()
             try:
                 middle, _ = _residual(problem, u + 0.5 * p, t, step)
@@ -375,7 +377,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             if ratio > 0.75:
                 shift = 0.0 if shift / 10.0 < opts.min_shift else shift / 10.0
                 if factor < 1.0:
-                    radius = min(2.0 * radius, opts.max_radius)
+                    radius = min(3.0 * radius, opts.max_radius)
             elif ratio < 0.25:
                 shift = min(max(2.0 * shift, opts.min_shift), opts.max_shift)
                 radius = max(0.5 * largest, opts.min_radius)
