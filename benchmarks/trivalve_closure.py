@@ -116,8 +116,8 @@ def main() -> int:
     parser.add_argument("--method", choices=("newton", "ptc"), default="ptc",
                         help="load-stepped Newton with damped steps, or pseudo-transient continuation (default)")
     _add_flags(parser, PTC_FLAGS, "ptc-", "skvalve.valve.closure.relaxation_options")
-    parser.add_argument("--held", choices=("ptc", "trust-region"), default="ptc",
-                        help="at the held load: keep relaxing by Ψtc, or switch to the energy trust region")
+    parser.add_argument("--held", choices=("ptc", "trust-region"), default="trust-region",
+                        help="at the held load: switch to the energy trust region (default), or keep relaxing by Ψtc")
     _add_flags(parser, TR_FLAGS, "tr-", "skvalve.fem.trust_region.TrustRegionOptions")
     parser.add_argument("--input", type=Path, default=None,
                         help="another TriValve input (.inp; default: the 1.0 diseased valve, $SKVALVE_TRIVALVE)")

@@ -611,9 +611,13 @@ if HAVE_DATA:
 #   `SurfaceContact` on the input's contact surfaces) by *pseudo-transient continuation* (`skvalve.fem.ptc`): one
 #   damped, linearised implicit-Euler step per pseudo-time step, no equilibrium asked for on the way, trust regions
 #   on nodal motion and on the tensile stretch of every hex edge and cable (the linear step from the toe of an
-#   exponential law into its steep part is what overshoots), and at the end the damping fades (switched evolution
-#   relaxation) so that the last steps are Newton's on the undamped problem. It prints all Table 2–3 rows of the
-#   diseased column, with a VTU/PVD series for ParaView. The load-stepped Newton closure of this section
+#   exponential law into its steep part is what overshoots). At the held load the valve is still closing, through
+#   directions of negative curvature, and damped steps only creep along them; there an *energy trust region*
+#   (`skvalve.fem.trust_region`) takes over: each step's energy change is the work of the residual along it
+#   (Simpson's rule), the step matrix is the tangent with every element block (and contact patch) projected onto its
+#   positive semidefinite part plus an inertia-corrected shift, and a step is kept when the energy falls by a fair
+#   share of what its quadratic model predicts. It prints all Table 2–3 rows of the diseased column, with a VTU/PVD
+#   series for ParaView. The load-stepped Newton closure of this section
 #   (`run_closure`, soft chords, converged damped steps) stalls in the tethering stage of the whole valve.
 # * `benchmarks/trivalve_closure.py --out DIR` runs the same closure and reports wall time, pseudo-steps, rejected
 #   steps, contact pairs and peak memory (`--resume` restarts from the last state kept on disk; `--resume --report`
