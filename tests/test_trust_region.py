@@ -8,7 +8,8 @@ import scipy.sparse as sp
 import skfem
 from scipy.optimize import brentq
 
-from skvalve.fem import NodalForce, Problem, Solid, Space, solve
+from skvalve.fem import HyperelasticTerm, MaterialRegions, NodalForce, Problem, Solid, Space, solve
+from skvalve.fem.block_relaxation import BlockRelaxation
 from skvalve.fem.errors import ConvergenceError
 from skvalve.fem.linsolve import LinearSolver, available_solvers
 from skvalve.fem.truss import Truss
@@ -21,7 +22,7 @@ from skvalve.fem.trust_region import (
     work_along,
 )
 from skvalve.materials import NeoHookean
-from skvalve.materials.uniaxial import OgdenUniaxial
+from skvalve.materials.uniaxial import OgdenUniaxial, TensionOnly
 
 
 def _sheared_block() -> Solid:
@@ -172,3 +173,46 @@ def test_bad_options_and_giving_up_keep_the_last_state():
                      progress=False)
     state = info.value.last_state
     assert len(state.residuals) == 2 and np.isfinite(state.u).all() and state.relative_residual < 1.0
+
+
+def _tethered_block(slack_fraction: float = 1e-6):
+    """A unit block (2x2x2 hexes) clamped at x = 0, tethered from its x = 1 face by four tension-only Ogden cables to
+    a hub (a vertex of no cell) that a fifth cable ties to an anchor pulled 0.4 along x. Returns problem, hub, law."""
+    block = skfem.MeshHex().refined(1)
+    extra = np.array([[1.6, 0.5, 0.5], [2.0, 0.5, 0.5]]).T  # hub, anchor: numbered first (below the cells' vertices)
+    mesh = skfem.MeshHex(np.hstack([extra, block.p]), block.t + 2)
+    space = Space(mesh)
+    X = mesh.p
+    corners = [int(np.flatnonzero(np.all(np.isclose(X.T, c), axis=1))[0])
+               for c in ([1, 0, 0], [1, 1, 0], [1, 0, 1], [1, 1, 1])]
+    law = TensionOnly(OgdenUniaxial((0.5,), (8.0,)), slack_fraction=slack_fraction)
+    cables = [[c, 0] for c in corners] + [[0, 1]]
+    problem = Problem(space, [HyperelasticTerm(space, MaterialRegions(mesh, NeoHookean(1.0, 5.0)))])
+    truss = problem.add_term(Truss(space, cables, 0.01, law))
+    problem.add_dirichlet(nodes=np.flatnonzero(np.isclose(X[0], 0.0) & (np.arange(X.shape[1]) >= 2)), value=0.0)
+    problem.add_dirichlet(nodes=[1], value=np.array([0.4, 0.0, 0.0]))
+    return problem, truss, 0
+
+
+def test_block_relaxation_of_a_hub_keeps_it_balanced_and_the_end_state():
+    """Relaxing the hub (only cables pull on it) after every accepted step leaves it in balance at every step, lowers
+    the energy, and changes the path, not the equilibrium: the end state is the one reached without it."""
+    problem, truss, hub = _tethered_block()
+    plain = trust_region(problem, 1.0, np.zeros(problem.space.n_dofs), TrustRegionOptions(rtol=1e-10),
+                         progress=False)
+    problem, truss, hub = _tethered_block()
+    relax = BlockRelaxation(problem, problem.space.displacement_dofs(np.array([hub])).ravel(), [truss], tol=1e-12)
+    balance = []
+
+    def hub_residual(event):
+        balance.append(float(np.linalg.norm(relax.residual(event.u, 1.0)[0])))
+
+    relaxed = trust_region(problem, 1.0, np.zeros(problem.space.n_dofs), TrustRegionOptions(rtol=1e-10),
+                           progress=False, relax=relax, callbacks=[hub_residual])
+    assert plain.converged and relaxed.converged
+    np.testing.assert_allclose(relaxed.u, plain.u, atol=1e-8 * np.abs(plain.u).max())
+    assert max(balance) <= 1e-12 and all(change < 0.0 for change in relaxed.energy_changes)
+    # the block's residual is the cables' force on the hub, and a term left out that touches it is refused
+    with pytest.raises(ValueError, match="also acts"):
+        face_node = int(np.flatnonzero(np.isclose(problem.space.mesh.p[0], 1.0))[0])  # in a hex and a cable
+        BlockRelaxation(problem, problem.space.displacement_dofs(np.array([face_node])).ravel(), [truss])

@@ -50,6 +50,7 @@ from scipy.sparse.csgraph import connected_components
 from tqdm.auto import tqdm
 
 from . import linsolve
+from .block_relaxation import BlockRelaxation
 from .errors import ConvergenceError, NonPositiveJacobianError
 from .newton import reference_force
 from .problem import Problem, Tangent
@@ -242,8 +243,12 @@ class _Attempt(Exception):
 def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegionOptions | None = None, *,
                  edges: np.ndarray | None = None, rest_lengths: np.ndarray | None = None,
                  callbacks: Sequence[Callable[[TrustRegionStep], None]] = (), progress: bool = True,
-                 verbose: bool = False) -> TrustRegionResult:
+                 verbose: bool = False, relax: BlockRelaxation | None = None) -> TrustRegionResult:
     """Relax ``problem`` at the held load factor ``t`` from ``u0`` to an equilibrium (module docstring).
+
+    ``relax``: a :class:`~skvalve.fem.block_relaxation.BlockRelaxation` run before the first step and after each
+    accepted one (e.g. the chordae branch points brought to equilibrium with the rest held); its energy change is
+    added to the step's.
 
     ``edges``/``rest_lengths`` as in :func:`~skvalve.fem.ptc.pseudo_transient`. Returns a :class:`TrustRegionResult`
     with ``converged`` set; raises :class:`~skvalve.fem.errors.ConvergenceError` (``error.last_state``: the result up
@@ -269,6 +274,8 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
     solvers = (linsolve.LinearSolver(solver_name, symmetric=True), linsolve.LinearSolver(solver_name, symmetric=True),
                linsolve.LinearSolver(solver_name, symmetric=problem.symmetric))  # shifted H, K_s's inertia, K
     clock = time.perf_counter()
+    if relax is not None:
+        u, _ = relax(u, t)
     residual, tangent = problem.assemble(u, t, tangent=True, step=0)
     result.timings["assembly"] += time.perf_counter() - clock
     norm = float(np.linalg.norm(residual[free]))
@@ -363,6 +370,15 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             local *= opts.local_decay
             local[local < opts.min_shift] = 0.0
             u, residual, tangent = u + p, trial_residual, trial_tangent
+            if relax is not None:
+                clock = time.perf_counter()
+                relaxed, inner = relax(u, t)
+                if inner.iterations:
+                    u = relaxed
+                    residual, tangent = problem.assemble(u, t, tangent=True, step=step)
+                    problem.commit()
+                    work += inner.energy_change
+                result.timings["assembly"] += time.perf_counter() - clock
             norm = float(np.linalg.norm(residual[free]))
             relative = norm / reference_force(problem, residual, fixed)
             result.u, result.relative_residual = u, relative

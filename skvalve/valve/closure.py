@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ..fem.amplitudes import GeometricRamp, smooth_step_polynomial
+from ..fem.block_relaxation import BlockRelaxation
 from ..fem.contact import SurfaceContact
 from ..fem.damping import ViscousDamping, lumped_volume, undamped_residual
 from ..fem.newton import StepEvent, solve
@@ -41,7 +42,7 @@ from .model import ValveModel, valve_model
 from .surfaces import contact_surface, thinnest_stack
 
 __all__ = ["ClosureOptions", "ClosureSetup", "ClosureRun", "EveryLoadFactor", "StagedDamping",
-           "closure_setup", "contact_surface", "damping_weights", "load_factors", "relax_closure",
+           "closure_setup", "contact_surface", "damping_weights", "hub_relaxation", "load_factors", "relax_closure",
            "relaxation_options", "run_closure", "watched_edges"]
 
 
@@ -339,8 +340,9 @@ def relax_closure(setup: ClosureSetup, end: float,
     equilibrium. ``setup`` must have no damping term (``ClosureOptions(damping=0)``): the damping is the
     solver's, with :func:`damping_weights`. ``options``: one set, or stages ``(until, options)`` run one after the
     other (:func:`relaxation_options`). ``held``: relax at the held load with the energy trust region
-    (:func:`~skvalve.fem.trust_region.trust_region`) instead, from the first state Ψtc reaches there (its last
-    stage then stops as soon as the load is held, once its relative residual is below 1). Never raises for a failed
+    (:func:`~skvalve.fem.trust_region.trust_region`, with the chordae branch points relaxed after each step:
+    :func:`hub_relaxation`) instead, from the first state Ψtc reaches there (its last stage then stops as soon as the
+    load is held, once its relative residual is below 1). Never raises for a failed
     run: the error and the kept state are recorded (the last accepted one; after Ψtc gave up at the held load, the
     held state with the smallest residual).
     """
@@ -380,8 +382,9 @@ def relax_closure(setup: ClosureSetup, end: float,
             if stop >= end:
                 break
         if held is not None:
+            hubs = hub_relaxation(setup) if setup.model is not None else None
             result = trust_region(setup.problem, end, u0, held, edges=edges, rest_lengths=rest_lengths,
-                                  callbacks=[record, *callbacks], progress=progress, verbose=verbose)
+                                  callbacks=[record, *callbacks], progress=progress, verbose=verbose, relax=hubs)
             add_effort(result)
     except Exception as err:  # noqa: BLE001 - a failed closure is a result to report, with its last state
         run.error = f"{type(err).__name__}: {err}"
@@ -397,6 +400,20 @@ def relax_closure(setup: ClosureSetup, end: float,
     if run.u is not None:
         run.undamped_residual = undamped_residual(setup.problem, run.u, run.load_factors[-1])
     return run
+
+
+def hub_relaxation(setup: ClosureSetup) -> BlockRelaxation | None:
+    """The chordae branch points (vertices of no leaflet cell, not prescribed) brought to equilibrium with the rest
+    held, by the cables alone (:mod:`skvalve.fem.block_relaxation`); None when the model has none."""
+    mesh = setup.model.mesh
+    in_cell = np.zeros(mesh.p.shape[1], dtype=bool)
+    in_cell[np.unique(mesh.t)] = True
+    hubs = np.flatnonzero(~in_cell)
+    trusses = [term for term in setup.problem.terms if isinstance(term, Truss)]
+    if hubs.size == 0 or not trusses:
+        return None
+    relax = BlockRelaxation(setup.problem, setup.problem.space.displacement_dofs(hubs).ravel(), trusses)
+    return relax if relax.dofs.size else None
 
 
 def watched_edges(model: ValveModel) -> tuple[np.ndarray, np.ndarray]:
