@@ -231,6 +231,7 @@ class SurfaceContact(Term):
         self.last_energy = 0.0
         self._assembled_u: np.ndarray | None = None
         self._committed_u: np.ndarray | None = None  # blended contact: the state whose normals give the facing
+        self._committed_pairs: ActivePairs | None = None  # the pairs at the last commit (inadmissible())
 
     # ------------------------------------------------------------------ search
     def active_pairs(self, u: np.ndarray) -> ActivePairs:
@@ -311,6 +312,30 @@ class SurfaceContact(Term):
         """Blended contact: the last assembled state becomes the one whose normals set the facing factors."""
         if self.blend > 0.0 and self._assembled_u is not None:
             self._committed_u = self._assembled_u
+        self._committed_pairs = self.last_pairs
+
+    def inadmissible(self, depth_fraction: float = 0.5) -> tuple[str, np.ndarray] | None:
+        """Why the last assembled state is no fair trial of a step from the last committed one, with the nodes
+        concerned, or None: a node that passed ``depth_fraction`` of the search depth :math:`g_\text{max}` through a
+        face since the commit, or one that was half that deep then and is in no pair now. A penalty energy ignores a
+        node past :math:`g_\text{max}`, so a method that follows the energy down could otherwise push nodes through a
+        sheet."""
+        pairs = self.last_pairs
+        if pairs is None:
+            return None
+        limit = depth_fraction * self.max_penetration
+        committed = self._committed_pairs
+        before = np.zeros(0, dtype=np.int64) if committed is None else committed.node[committed.gap < -limit]
+        deep = np.setdiff1d(pairs.node[pairs.gap < -limit], before)
+        if deep.size:
+            return (f"contact: node(s) {deep[:5].tolist()} passed {limit:.3g} (half the search depth) through a face",
+                    deep)
+        if committed is not None and committed.size:
+            pressed = np.unique(committed.node[committed.gap < -0.5 * limit])
+            lost = np.setdiff1d(pressed, pairs.node)
+            if lost.size:
+                return f"contact: pressed node(s) {lost[:5].tolist()} left every pair (through a face?)", lost
+        return None
 
     @property
     def above(self) -> float:
