@@ -22,7 +22,6 @@ from pathlib import Path
 import numpy as np
 
 from skvalve.fem.damping import undamped_residual
-from skvalve.fem.trust_region import TrustRegionOptions
 from skvalve.io.abaqus import read_model, trivalve_input
 from skvalve.io.files import replace_atomically
 from skvalve.papers.mathur2022.figures import write_figures
@@ -30,6 +29,7 @@ from skvalve.valve.closure import (
     ClosureOptions,
     ClosureRun,
     closure_setup,
+    held_options,
     relax_closure,
     relaxation_options,
     run_closure,
@@ -87,7 +87,7 @@ PTC_FLAGS = {
 #: flags --tr-<name> that override a TrustRegionOptions field (with --held trust-region)
 TR_FLAGS = {
     "radius": (float, "first trust-region radius: the most a node may move in one step (mm)"),
-    "max_radius": (float, "largest trust-region radius (mm)"),
+    "max_radius": (float, "largest trust-region radius (mm; default: the contact search depth)"),
     "max_strain_increment": (float, "largest change of an edge's or cable's tensile stretch per step"),
     "shift": (float, "first shift of the step matrix, relative to its diagonal"),
     "project": (int, "1: project the solid's and cables' element blocks onto positive semidefinite ones"),
@@ -118,7 +118,7 @@ def main() -> int:
     _add_flags(parser, PTC_FLAGS, "ptc-", "skvalve.valve.closure.relaxation_options")
     parser.add_argument("--held", choices=("ptc", "trust-region"), default="trust-region",
                         help="at the held load: switch to the energy trust region (default), or keep relaxing by Ψtc")
-    _add_flags(parser, TR_FLAGS, "tr-", "skvalve.fem.trust_region.TrustRegionOptions")
+    _add_flags(parser, TR_FLAGS, "tr-", "skvalve.valve.closure.held_options")
     parser.add_argument("--input", type=Path, default=None,
                         help="another TriValve input (.inp; default: the 1.0 diseased valve, $SKVALVE_TRIVALVE)")
     args = parser.parse_args()
@@ -177,7 +177,7 @@ def main() -> int:
             tr = {name: getattr(args, "tr_" + name) for name in TR_FLAGS if getattr(args, "tr_" + name) is not None}
             if "project" in tr:
                 tr["project"] = bool(tr["project"])
-            held = TrustRegionOptions(rtol=options.rtol, atol=options.atol, **tr)
+            held = held_options(setup, rtol=options.rtol, atol=options.atol, **tr)
             print(f"held load: {held}", flush=True)
         run = relax_closure(setup, options.end, ptc_options, callbacks=[LastState(args.out)], progress=False,
                             verbose=args.verbose, u0=u0, t0=t0, held=held)

@@ -108,8 +108,8 @@ def test_a_trust_region_at_the_held_load_ends_where_the_load_stepped_closure_doe
 
 def test_contact_refuses_trial_states_that_push_nodes_towards_the_end_of_its_search_depth():
     """A penalty energy ignores nodes past the search depth g_max, so an energy-following step could push nodes through
-    a sheet: a trial state with a node newly deeper than g_max / 2, or one that loses a node pressed g_max / 4 deep at
-    the last commit, is refused with the nodes named; a shallow one, or one deep since the commit, is fair."""
+    a sheet: a trial state with a node newly deeper than g_max / 2 is refused with the nodes named; a shallow one, or
+    one deep since the commit, is fair."""
     setup = _blocks_setup(0.15, damped=False, blend=0.1)
     contact, space = setup.contact, setup.problem.space
     g_max = contact.max_penetration
@@ -124,14 +124,6 @@ def test_contact_refuses_trial_states_that_push_nodes_towards_the_end_of_its_sea
     contact.commit()  # deep, committed: staying deep is fair
     contact.assemble(u, 1.5, False, None)
     assert contact.inadmissible() is None
-    u[3 * upper + 2] = -0.4 * g_max  # pressed, and committed
-    contact.assemble(u, 1.5, False, None)
-    assert contact.inadmissible() is None
-    contact.commit()
-    u[3 * upper + 2] = -1.2 * g_max  # past the search depth: no pair left
-    contact.assemble(u, 1.5, False, None)
-    message, nodes = contact.inadmissible()
-    assert "left every pair" in message and nodes.size > 0
 
 
 def test_contact_pairs_closer_than_exclude_within_in_the_reference_are_never_active():

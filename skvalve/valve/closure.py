@@ -42,8 +42,8 @@ from .model import ValveModel, valve_model
 from .surfaces import contact_surface, thinnest_stack
 
 __all__ = ["ClosureOptions", "ClosureSetup", "ClosureRun", "EveryLoadFactor", "StagedDamping",
-           "closure_setup", "contact_surface", "damping_weights", "hub_relaxation", "load_factors", "relax_closure",
-           "relaxation_options", "run_closure", "watched_edges"]
+           "closure_setup", "contact_surface", "damping_weights", "held_options", "hub_relaxation", "load_factors",
+           "relax_closure", "relaxation_options", "run_closure", "watched_edges"]
 
 
 @dataclass
@@ -400,6 +400,14 @@ def relax_closure(setup: ClosureSetup, end: float,
     if run.u is not None:
         run.undamped_residual = undamped_residual(setup.problem, run.u, run.load_factors[-1])
     return run
+
+
+def held_options(setup: ClosureSetup, **overrides) -> TrustRegionOptions:
+    """Trust-region controls for the held load of a valve closure: steps of at most the contact search depth on any
+    node (so that no node jumps through a sheet in one step: :meth:`~skvalve.fem.contact.SurfaceContact.inadmissible`
+    refuses the gradual way), first radius a quarter of it, and ``overrides`` (e.g. ``rtol``, ``atol``)."""
+    depth = setup.contact.max_penetration
+    return TrustRegionOptions(**{"radius": 0.25 * depth, "max_radius": depth, **overrides})
 
 
 def hub_relaxation(setup: ClosureSetup) -> BlockRelaxation | None:
