@@ -108,8 +108,8 @@ def test_a_trust_region_at_the_held_load_ends_where_the_load_stepped_closure_doe
 
 def test_contact_refuses_trial_states_that_push_nodes_towards_the_end_of_its_search_depth():
     """A penalty energy ignores nodes past the search depth g_max, so an energy-following step could push nodes through
-    a sheet: a trial state with a node newly deeper than g_max / 2 is refused with the nodes named; a shallow one, or
-    one deep since the commit, is fair."""
+    a sheet: a trial state with a node that passed g_max / 2 in one step (from less than g_max / 4) is refused with the
+    nodes named; a shallow one, or one deep since the commit that creeps deeper, is fair."""
     setup = _blocks_setup(0.15, damped=False, blend=0.1)
     contact, space = setup.contact, setup.problem.space
     g_max = contact.max_penetration
@@ -121,7 +121,8 @@ def test_contact_refuses_trial_states_that_push_nodes_towards_the_end_of_its_sea
         contact.assemble(u, 1.5, False, None)
         result = contact.inadmissible()
         assert (result is None) if verdict is None else (verdict in result[0] and result[1].size > 0)
-    contact.commit()  # deep, committed: staying deep is fair
+    contact.commit()  # deep, committed: staying deep, or creeping deeper, is fair
+    u[3 * upper + 2] = -0.75 * g_max
     contact.assemble(u, 1.5, False, None)
     assert contact.inadmissible() is None
 

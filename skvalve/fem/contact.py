@@ -317,7 +317,8 @@ class SurfaceContact(Term):
     def inadmissible(self, depth_fraction: float = 0.5) -> tuple[str, np.ndarray] | None:
         """Why the last assembled state is no fair trial of a step from the last committed one, with the nodes
         concerned, or None: a node that passed ``depth_fraction`` of the search depth :math:`g_\text{max}` through a
-        face since the commit (one already deeper then is left alone). A penalty energy ignores a node past
+        face in one step, from less than half that depth at the commit (one that creeps deeper is left to the
+        penalty, which resists it). A penalty energy ignores a node past
         :math:`g_\text{max}`, so a method that follows the energy down could otherwise push nodes through a sheet;
         with steps shorter than the depth (:func:`skvalve.valve.closure.held_options`) none can jump past it in
         one step. (A node that leaves every pair is not refused: it may have slid past a free edge.)"""
@@ -326,11 +327,11 @@ class SurfaceContact(Term):
             return None
         limit = depth_fraction * self.max_penetration
         committed = self._committed_pairs
-        before = np.zeros(0, dtype=np.int64) if committed is None else committed.node[committed.gap < -limit]
+        before = np.zeros(0, dtype=np.int64) if committed is None else committed.node[committed.gap < -0.5 * limit]
         deep = np.setdiff1d(pairs.node[pairs.gap < -limit], before)
         if deep.size:
-            return (f"contact: node(s) {deep[:5].tolist()} passed {limit:.3g} (half the search depth) through a face",
-                    deep)
+            return (f"contact: node(s) {deep[:5].tolist()} passed {limit:.3g} (half the search depth) through a face "
+                    "in one step", deep)
         return None
 
     @property
