@@ -106,27 +106,6 @@ def test_a_trust_region_at_the_held_load_ends_where_the_load_stepped_closure_doe
     assert relaxed.undamped_residual[1] < 1e-9
 
 
-def test_contact_refuses_trial_states_that_push_nodes_towards_the_end_of_its_search_depth():
-    """A penalty energy ignores nodes past the search depth g_max, so an energy-following step could push nodes through
-    a sheet: a trial state with a node that passed g_max / 2 in one step (from less than g_max / 4) is refused with the
-    nodes named; a shallow one, or one deep since the commit that creeps deeper, is fair."""
-    setup = _blocks_setup(0.15, damped=False, blend=0.1)
-    contact, space = setup.contact, setup.problem.space
-    g_max = contact.max_penetration
-    # the upper block's vertices (its contact face included): moved down as one into the lower block
-    upper = np.unique(space.mesh.t[:, space.mesh.p[2, space.mesh.t].min(axis=0) >= 1.0])
-    u = np.zeros(space.n_dofs)
-    for depth, verdict in ((0.1 * g_max, None), (0.7 * g_max, "passed")):
-        u[3 * upper + 2] = -depth
-        contact.assemble(u, 1.5, False, None)
-        result = contact.inadmissible()
-        assert (result is None) if verdict is None else (verdict in result[0] and result[1].size > 0)
-    contact.commit()  # deep, committed: staying deep, or creeping deeper, is fair
-    u[3 * upper + 2] = -0.75 * g_max
-    contact.assemble(u, 1.5, False, None)
-    assert contact.inadmissible() is None
-
-
 def test_contact_pairs_closer_than_exclude_within_in_the_reference_are_never_active():
     """The two faces at z = 1 coincide in the reference: pressed 0.1 into each other, every node pairs (9 per face,
     two passes). A node over a triangle lies at most its circumradius (0.37 here) from the centroid in the

@@ -231,7 +231,6 @@ class SurfaceContact(Term):
         self.last_energy = 0.0
         self._assembled_u: np.ndarray | None = None
         self._committed_u: np.ndarray | None = None  # blended contact: the state whose normals give the facing
-        self._committed_pairs: ActivePairs | None = None  # the pairs at the last commit (inadmissible())
 
     # ------------------------------------------------------------------ search
     def active_pairs(self, u: np.ndarray) -> ActivePairs:
@@ -312,30 +311,6 @@ class SurfaceContact(Term):
         """Blended contact: the last assembled state becomes the one whose normals set the facing factors."""
         if self.blend > 0.0 and self._assembled_u is not None:
             self._committed_u = self._assembled_u
-        self._committed_pairs = self.last_pairs
-
-    def inadmissible(self, depth_fraction: float = 0.5) -> tuple[str, np.ndarray] | None:
-        r"""Why the last assembled state is no fair trial of a step from the last committed one, with the nodes
-        concerned, or None: a node that passed ``depth_fraction`` of the search depth :math:`g_\text{max}` through a
-        face in one step, from less than half that depth at the commit (one that creeps deeper is left to the
-        penalty, which resists it). Only pairs whose projection lies inside their triangle and that face each other
-        (facing factor at least 1/2) count: a pair at a band's edge enters the list with no share, at any depth.
-        A penalty energy ignores a node past :math:`g_\text{max}`, so a method that follows the energy down could
-        otherwise push nodes through a sheet; with steps shorter than the depth
-        (:func:`skvalve.valve.closure.held_options`) none can jump past it in one step. (A node that leaves every
-        pair is not refused: it may have slid past a free edge.)"""
-        pairs = self.last_pairs
-        if pairs is None:
-            return None
-        limit = depth_fraction * self.max_penetration
-        committed = self._committed_pairs
-        before = np.zeros(0, dtype=np.int64) if committed is None else \
-            committed.node[(committed.gap < -0.5 * limit) & _full_share(committed)]
-        deep = np.setdiff1d(pairs.node[(pairs.gap < -limit) & _full_share(pairs)], before)
-        if deep.size:
-            return (f"contact: node(s) {deep[:5].tolist()} passed {limit:.3g} (half the search depth) through a face "
-                    "in one step", deep)
-        return None
 
     @property
     def above(self) -> float:
@@ -495,12 +470,6 @@ class SurfaceContact(Term):
         Q = x[self.surface.quads]
         area = 0.5 * np.linalg.norm(np.cross(Q[:, 2] - Q[:, 0], Q[:, 3] - Q[:, 1]), axis=1)
         return float(area[pressure > threshold].sum())
-
-
-def _full_share(pairs: ActivePairs) -> np.ndarray:
-    """Pairs whose node projects inside its triangle and whose normals face each other (facing factor >= 1/2)."""
-    inside = pairs.weights.min(axis=1) >= 0.0
-    return inside if pairs.facing is None else inside & (pairs.facing >= 0.5)
 
 
 def _constant(value: float, name: str):

@@ -237,12 +237,7 @@ def work_along(r_start: np.ndarray, r_middle: np.ndarray, r_end: np.ndarray, ste
 
 
 class _Attempt(Exception):
-    """A step that failed before its energy could be measured (a non-finite residual, a state a term refuses), with
-    the nodes to shift locally (if any)."""
-
-    def __init__(self, message: str, nodes: np.ndarray | None = None) -> None:
-        super().__init__(message)
-        self.nodes = nodes
+    """A step that failed before its energy could be measured (a non-finite residual)."""
 
 
 def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegionOptions | None = None, *,
@@ -342,21 +337,11 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                 trial_residual, trial_tangent = problem.assemble(u + p, t, tangent=True, step=step)
                 if not np.all(np.isfinite(trial_residual)):
                     raise _Attempt("the residual is not finite")
-                for term in problem.terms:  # e.g. contact: no node pushed towards the end of the search depth
-                    check = getattr(term, "inadmissible", None)
-                    verdict = check() if check is not None else None
-                    if verdict is not None:
-                        raise _Attempt(verdict[0], verdict[1])
             except (NonPositiveJacobianError, _Attempt) as err:
                 result.timings["assembly"] += time.perf_counter() - clock
                 problem.rewind()
                 result.rejected += 1
                 radius = 0.5 * largest
-                nodes = getattr(err, "nodes", None)
-                if opts.local_shift > 0.0 and nodes is not None and nodes.size:
-                    dofs = space.displacement_dofs(nodes).ravel()
-                    local[dofs] = np.maximum(10.0 * local[dofs], opts.local_shift)
-                    radius = 0.7 * largest
                 logger.info("trust-region step %d rejected: %s", step, err)
                 if verbose:
                     print(f"  rejected step {step}: {err}; radius {radius:.3g}", flush=True)

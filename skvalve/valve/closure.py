@@ -404,8 +404,8 @@ def relax_closure(setup: ClosureSetup, end: float,
 
 def held_options(setup: ClosureSetup, **overrides) -> TrustRegionOptions:
     """Trust-region controls for the held load of a valve closure: steps of at most the contact search depth on any
-    node (so that no node jumps through a sheet in one step: :meth:`~skvalve.fem.contact.SurfaceContact.inadmissible`
-    refuses the gradual way), first radius a quarter of it, and ``overrides`` (e.g. ``rtol``, ``atol``)."""
+    node (a penalty energy ignores a node past that depth, so an energy-following step longer than it could carry a
+    node through a sheet), first radius a quarter of it, and ``overrides`` (e.g. ``rtol``, ``atol``)."""
     depth = setup.contact.max_penetration
     return TrustRegionOptions(**{"radius": 0.25 * depth, "max_radius": depth, **overrides})
 
