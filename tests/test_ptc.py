@@ -5,33 +5,23 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-import skfem
-from _truss_checks import two_nodes
+from _truss_checks import sheared_block, two_nodes
 from scipy.optimize import brentq
 
-from skvalve.fem import NodalForce, Problem, Solid, solve
+from skvalve.fem import NodalForce, Problem, solve
 from skvalve.fem.damping import lumped_volume
 from skvalve.fem.errors import ConvergenceError
 from skvalve.fem.ptc import PseudoTransientOptions, _carriers, pseudo_transient
 from skvalve.fem.terms import Blocks, Contribution, Term
 from skvalve.fem.truss import Truss
-from skvalve.materials import NeoHookean
 from skvalve.materials.uniaxial import OgdenUniaxial, TensionOnly
-
-
-def _sheared_block() -> Solid:
-    """A unit block (4x4x4 hexes) clamped at x = 0 whose face x = 1 is moved 0.5 along z: bending and shear."""
-    solid = Solid(skfem.MeshHex().refined(2), NeoHookean(1.0, 10.0))
-    solid.add_dirichlet(lambda X: X[0] == 0.0, 0.0)
-    solid.add_dirichlet(lambda X: X[0] == 1.0, np.array([0.0, 0.0, 0.5]))
-    return solid
 
 
 def test_relaxes_to_the_equilibrium_newton_reaches():
     """An elastic problem is path independent: Ψtc (one damped linear step per pseudo-step, no equilibrium on the
     way) must end where 10 converged Newton load steps end, and its last steps must converge like Newton's."""
-    newton = solve(_sheared_block(), 10, progress=False, rtol=1e-11)
-    block = _sheared_block()
+    newton = solve(sheared_block(), 10, progress=False, rtol=1e-11)
+    block = sheared_block()
     seen = []
     result = pseudo_transient(block, lumped_volume(block.space), 1.0,
                               PseudoTransientOptions(damping=1.0, first_step=0.05, max_load_step=0.1, rtol=1e-11,
@@ -51,7 +41,7 @@ def test_relaxes_to_the_equilibrium_newton_reaches():
     assert result.residuals[-1] < 1e-6 * max(result.residuals)
     assert [event.step for event in seen] == list(range(1, len(result.pseudo_times) + 1))
     # a stiffness-proportional damping (here a function of the load factor) changes the path, not the end state
-    block = _sheared_block()
+    block = sheared_block()
     damped = pseudo_transient(block, lumped_volume(block.space), 1.0,
                               PseudoTransientOptions(damping=1.0, first_step=0.05, max_load_step=0.1, rtol=1e-11,
                                                      max_increment=None, stiffness_damping=lambda t: 0.05 * t),
@@ -63,8 +53,8 @@ def test_relaxes_to_the_equilibrium_newton_reaches():
 def test_held_growth_lengthens_every_step_whose_residual_does_not_grow():
     """``held_growth``: at the held load the pseudo-time step grows at least by that factor (at most by ``growth``)
     after each accepted step whose residual fell, and the end state is still Newton's."""
-    newton = solve(_sheared_block(), 10, progress=False, rtol=1e-11)
-    block = _sheared_block()
+    newton = solve(sheared_block(), 10, progress=False, rtol=1e-11)
+    block = sheared_block()
     options = PseudoTransientOptions(damping=1.0, first_step=0.05, max_load_step=0.1, rtol=1e-11, max_increment=None,
                                      max_strain_increment=None, stiffness_damping=0.5, held_growth=1.5, growth=3.0)
     result = pseudo_transient(block, lumped_volume(block.space), 1.0, options, progress=False)
@@ -74,7 +64,7 @@ def test_held_growth_lengthens_every_step_whose_residual_does_not_grow():
               for k in held[1:-1]]
     assert ratios and all(1.5 - 1e-12 <= ratio <= 3.0 + 1e-12 for ratio, fell in ratios if fell <= 1.0)
     # with pure SER (held_growth 1) the same problem takes more held steps
-    block = _sheared_block()
+    block = sheared_block()
     plain = pseudo_transient(block, lumped_volume(block.space), 1.0, replace(options, held_growth=1.0), progress=False)
     assert plain.converged and len(plain.pseudo_times) > len(result.pseudo_times)
     with pytest.raises(ValueError, match="held_growth"):
@@ -84,12 +74,12 @@ def test_held_growth_lengthens_every_step_whose_residual_does_not_grow():
 def test_held_stiffness_damping_replaces_the_stiffness_damping_once_the_load_is_held():
     """``held_stiffness_damping = 0``: the stiffness-proportional damping of the load path stops at the held load; the
     end state is still Newton's, reached in fewer held steps than with the damping kept."""
-    newton = solve(_sheared_block(), 10, progress=False, rtol=1e-11)
+    newton = solve(sheared_block(), 10, progress=False, rtol=1e-11)
     options = PseudoTransientOptions(damping=1.0, first_step=0.05, max_load_step=0.1, rtol=1e-11, max_increment=None,
                                      max_strain_increment=None, stiffness_damping=2.0)
     results = []
     for held in (None, 0.0):
-        block = _sheared_block()
+        block = sheared_block()
         results.append(pseudo_transient(block, lumped_volume(block.space), 1.0,
                                         replace(options, held_stiffness_damping=held), progress=False))
     kept, dropped = results

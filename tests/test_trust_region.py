@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import skfem
+from _truss_checks import sheared_block
 from scipy.optimize import brentq
 
-from skvalve.fem import HyperelasticTerm, MaterialRegions, NodalForce, Problem, Solid, Space, solve
+from skvalve.fem import HyperelasticTerm, MaterialRegions, NodalForce, Problem, Space, solve
 from skvalve.fem.block_relaxation import BlockRelaxation
 from skvalve.fem.errors import ConvergenceError
 from skvalve.fem.linsolve import LinearSolver, available_solvers
@@ -25,18 +26,11 @@ from skvalve.materials import NeoHookean
 from skvalve.materials.uniaxial import OgdenUniaxial, TensionOnly
 
 
-def _sheared_block() -> Solid:
-    solid = Solid(skfem.MeshHex().refined(2), NeoHookean(1.0, 10.0))
-    solid.add_dirichlet(lambda X: X[0] == 0.0, 0.0)
-    solid.add_dirichlet(lambda X: X[0] == 1.0, np.array([0.0, 0.0, 0.5]))
-    return solid
-
-
 def test_ends_where_load_stepped_newton_ends_and_finishes_with_newton_steps():
     """Path independence: from the reference at the full load (no load steps), the trust region must reach the
     state of 10 converged Newton load steps, every accepted step lowering the energy, the last steps Newton's."""
-    newton = solve(_sheared_block(), 10, progress=False, rtol=1e-11)
-    block = _sheared_block()
+    newton = solve(sheared_block(), 10, progress=False, rtol=1e-11)
+    block = sheared_block()
     seen = []
     result = trust_region(block, 1.0, np.zeros(block.space.n_dofs), TrustRegionOptions(rtol=1e-11, radius=0.1),
                           progress=False, callbacks=[seen.append])
@@ -140,7 +134,7 @@ def test_projected_blocks_are_the_nearest_semidefinite_ones():
     expected[np.ix_([1, 6, 7], [1, 6, 7])] = b @ b.T
     np.testing.assert_allclose(projected_sparse, expected, atol=1e-12)
     # on a solid in compression, the step matrix is the projected blocks assembled: positive semidefinite
-    block = _sheared_block()
+    block = sheared_block()
     u = np.zeros(block.space.n_dofs)
     u[block.pattern.fixed] = block.constrained(1.0)[1]
     _, tangent = block.assemble(u, 1.0)
@@ -165,7 +159,7 @@ def test_bad_options_and_giving_up_keep_the_last_state():
                 {"max_steps": 0}, {"atol": float("nan")}, {"min_shift": 10.0, "max_shift": 1.0}):
         with pytest.raises(ValueError, match="TrustRegionOptions"):
             TrustRegionOptions(**bad)
-    block = _sheared_block()
+    block = sheared_block()
     with pytest.raises(ValueError, match="finite"):
         trust_region(block, 1.0, np.full(block.space.n_dofs, np.nan), progress=False)
     with pytest.raises(ConvergenceError, match="2 steps without converging") as info:
