@@ -22,6 +22,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .problem import Problem
+from .trust_region import work_along
 
 __all__ = ["BlockRelaxation", "BlockRelaxationResult"]
 
@@ -136,7 +137,7 @@ class BlockRelaxation:
                 middle[self.dofs] += 0.5 * step
                 r_middle, _ = self.residual(middle, t)
                 r_end, K_end = self.residual(trial, t, tangent=True)
-                work = float((r + 4.0 * r_middle + r_end) @ step) / 6.0
+                work = work_along(r, r_middle, r_end, step)
                 if work < 0.0 and np.all(np.isfinite(r_end)):
                     accepted = True
                     break

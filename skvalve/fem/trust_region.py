@@ -50,7 +50,6 @@ from scipy.sparse.csgraph import connected_components
 from tqdm.auto import tqdm
 
 from . import linsolve
-from .block_relaxation import BlockRelaxation
 from .errors import ConvergenceError, NonPositiveJacobianError
 from .newton import reference_force
 from .problem import Problem, Tangent
@@ -243,12 +242,13 @@ class _Attempt(Exception):
 def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegionOptions | None = None, *,
                  edges: np.ndarray | None = None, rest_lengths: np.ndarray | None = None,
                  callbacks: Sequence[Callable[[TrustRegionStep], None]] = (), progress: bool = True,
-                 verbose: bool = False, relax: BlockRelaxation | None = None) -> TrustRegionResult:
+                 verbose: bool = False, relax: Callable[[np.ndarray, float], tuple] | None = None
+                 ) -> TrustRegionResult:
     """Relax ``problem`` at the held load factor ``t`` from ``u0`` to an equilibrium (module docstring).
 
-    ``relax``: a :class:`~skvalve.fem.block_relaxation.BlockRelaxation` run before the first step and after each
-    accepted one (e.g. the chordae branch points brought to equilibrium with the rest held); its energy change is
-    added to the step's.
+    ``relax``: a :class:`~skvalve.fem.block_relaxation.BlockRelaxation` (``relax(u, t) -> (u, result)``, the result
+    with ``iterations`` and ``energy_change``) run before the first step and after each accepted one (e.g. the
+    chordae branch points brought to equilibrium with the rest held); its energy change is added to the step's.
 
     ``edges``/``rest_lengths`` as in :func:`~skvalve.fem.ptc.pseudo_transient`. Returns a :class:`TrustRegionResult`
     with ``converged`` set; raises :class:`~skvalve.fem.errors.ConvergenceError` (``error.last_state``: the result up
