@@ -277,7 +277,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
     if relax is not None:
         u, _ = relax(u, t)
     residual, tangent = problem.assemble(u, t, tangent=True, step=0)
-    problem.commit()  # the start is the first accepted state (e.g. the contact pairs a trial is checked against)
+    problem.commit()  # the start is the first accepted state (e.g. blended contact's facing factors are taken there)
     result.timings["assembly"] += time.perf_counter() - clock
     norm = float(np.linalg.norm(residual[free]))
     relative = norm / reference_force(problem, residual, fixed)
