@@ -106,6 +106,7 @@ TR_FLAGS = {
     "shift": (float, "first shift of the step matrix, relative to its diagonal"),
     "project": (int, "1: project the solid's and cables' element blocks onto positive semidefinite ones"),
     "max_steps": (int, "the most accepted trust-region steps"),
+    "newton_below": (float, "relative residual below which a full-tangent Newton step is tried first (0: never)"),
 }
 
 
@@ -209,6 +210,8 @@ def main() -> int:
     print("where the time went (s): " + ", ".join(f"{key} {value:.1f}" for key, value in run.timings.items()))
     print(f"last converged step time {run.load_factors[-1]:.5g} of {options.end}; undamped residual "
           f"(norm, relative) {run.undamped_residual}")
+    if run.negative_eigenvalues is not None:
+        print(f"negative eigenvalues of the symmetric tangent at the converged state: {run.negative_eigenvalues}")
     if run.error:
         print(f"stopped: {run.error}")
     if run.u is not None:

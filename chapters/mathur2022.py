@@ -616,7 +616,10 @@ if HAVE_DATA:
 #   (`skvalve.fem.trust_region`) takes over: each step's energy change is the work of the residual along it
 #   (Simpson's rule), the step matrix is the tangent with every element block (and contact patch) projected onto its
 #   positive semidefinite part plus an inertia-corrected shift, and a step is kept when the energy falls by a fair
-#   share of what its quadratic model predicts. It prints all Table 2–3 rows of the diseased column, with a VTU/PVD
+#   share of what its quadratic model predicts. The follower pressure on leaflets with free edges is not
+#   conservative, so close to equilibrium that energy is only approximate; below a relative residual of 1e-4 each step
+#   first tries Newton's step with the full tangent and keeps it when the residual halves. It prints all Table 2–3
+#   rows of the diseased column, with a VTU/PVD
 #   series for ParaView. The load-stepped Newton closure of this section
 #   (`run_closure`, soft chords, converged damped steps) stalls in the tethering stage of the whole valve.
 # * `benchmarks/trivalve_closure.py --out DIR` runs the same closure and reports wall time, pseudo-steps, rejected

@@ -2,6 +2,8 @@
 region of negative curvature to the stable equilibrium, measures the energy change exactly where it can, and fails
 clearly."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -9,10 +11,11 @@ import skfem
 from _truss_checks import sheared_block
 from scipy.optimize import brentq
 
-from skvalve.fem import HyperelasticTerm, MaterialRegions, NodalForce, Problem, Space, solve
+from skvalve.fem import HyperelasticTerm, MaterialRegions, NodalForce, Problem, Solid, Space, solve
 from skvalve.fem.block_relaxation import BlockRelaxation
 from skvalve.fem.errors import ConvergenceError
 from skvalve.fem.linsolve import LinearSolver, available_solvers
+from skvalve.fem.loads import FollowerPressure
 from skvalve.fem.truss import Truss
 from skvalve.fem.trust_region import (
     TrustRegionOptions,
@@ -42,6 +45,46 @@ def test_ends_where_load_stepped_newton_ends_and_finishes_with_newton_steps():
     assert min(result.ratios) >= 0.1 and result.newton_steps >= 1 and result.shifts[-1] == 0.0
     assert result.largest_increments[0] == pytest.approx(0.1)  # the first step was held to the radius
     assert [event.step for event in seen] == list(range(1, len(result.residuals) + 1))
+
+
+def _flap(pressure: float = 2e-3):
+    """A 4 x 1 x 0.2 neo-Hookean flap clamped at x = 0 under a follower pressure on its top: the pressure on a surface
+    with free edges is not conservative, and at this load the curled flap's symmetric tangent is indefinite."""
+    mesh = skfem.MeshHex.init_tensor(np.linspace(0.0, 4.0, 9), np.linspace(0.0, 1.0, 2), np.linspace(0.0, 0.2, 2))
+    flap = Solid(mesh, NeoHookean(1.0, 10.0))
+    flap.add_dirichlet(lambda X: np.isclose(X[0], 0.0), 0.0)
+    top = mesh.facets_satisfying(lambda x: np.isclose(x[2], 0.2), boundaries_only=True)
+    flap.add_term(FollowerPressure(flap.space, top, pressure))
+    return flap
+
+
+@pytest.mark.skipif("pardiso" not in available_solvers(), reason="the inertia needs PARDISO")
+def test_newton_tries_converge_where_the_energy_model_of_a_follower_load_stalls():
+    """The curled flap: the load-stepped Newton state has one negative eigenvalue of K_s, so it is no minimum of any
+    energy and the energy trust region circles it (300 steps, residual 1e-2 to 1e-6); with full-tangent Newton tries
+    below 1e-2 the run ends on that state, and reports the eigenvalue."""
+    newton = solve(_flap(), 10, progress=False, rtol=1e-10).u()
+    options = TrustRegionOptions(rtol=1e-10, radius=0.2, max_radius=2.0, max_steps=150)
+    with pytest.raises(ConvergenceError, match="150 steps without converging"):
+        trust_region(_flap(), 1.0, np.zeros(newton.size), options, progress=False)
+    result = trust_region(_flap(), 1.0, np.zeros(newton.size), replace(options, newton_below=1e-2), progress=False)
+    assert result.converged and result.negative_eigenvalues == 1
+    assert np.abs(result.u - newton).max() <= 1e-9 * np.abs(newton).max()
+    assert 1 <= result.newton_tries and np.isnan(result.ratios[-1])  # the last step was a kept Newton try
+    tail = np.array(result.residuals[-3:])  # quadratic: each residual about the square of the one before
+    assert np.log(tail[2] / tail[1]) / np.log(tail[1] / tail[0]) >= 1.6
+
+
+def test_a_failed_newton_try_is_rewound():
+    """Tries asked to cut the residual to 1e-14 of itself all fail: the run ends where the plain trust region ends."""
+    plain = trust_region(sheared_block(), 1.0, np.zeros(sheared_block().space.n_dofs),
+                         TrustRegionOptions(rtol=1e-11, radius=0.1), progress=False)
+    tried = trust_region(sheared_block(), 1.0, np.zeros(plain.u.size),
+                         TrustRegionOptions(rtol=1e-11, radius=0.1, newton_below=1.0, newton_decrease=1e-14),
+                         progress=False)
+    assert tried.converged and tried.newton_tries >= 1 and tried.newton_steps == plain.newton_steps
+    assert np.abs(tried.u - plain.u).max() <= 1e-9 * np.abs(plain.u).max()
+    assert tried.residuals == pytest.approx(plain.residuals, rel=1e-6)
 
 
 def _arch(load: float):
@@ -156,7 +199,8 @@ def test_the_symmetric_factorisation_reports_the_inertia():
 
 def test_bad_options_and_giving_up_keep_the_last_state():
     for bad in ({"radius": 0.0}, {"eta": 0.5}, {"min_radius": 1.0, "radius": 0.5}, {"max_strain_increment": -1.0},
-                {"max_steps": 0}, {"atol": float("nan")}, {"min_shift": 10.0, "max_shift": 1.0}):
+                {"max_steps": 0}, {"atol": float("nan")}, {"min_shift": 10.0, "max_shift": 1.0},
+                {"newton_below": -1.0}, {"newton_decrease": 1.0}):
         with pytest.raises(ValueError, match="TrustRegionOptions"):
             TrustRegionOptions(**bad)
     block = sheared_block()

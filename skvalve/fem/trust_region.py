@@ -32,7 +32,12 @@ ratio steers both controls: a good model (:math:`\rho > 3/4`) lowers :math:`\alp
 :math:`\Delta` threefold, a poor one raises :math:`\alpha`; a rejected step gives the nodes that carry its energy rise a
 local shift, or halves :math:`\Delta`. With :math:`\alpha = 0` and a tangent whose
 symmetric part is positive definite the step is Newton's with the full tangent, and the last iterations converge
-quadratically. The residual is always the undamped one: converged means :math:`\lVert R_f\rVert \le
+quadratically. A follower pressure on an open surface (leaflets with free edges) makes the problem non-conservative:
+near the equilibrium the work of its non-symmetric part is as large as the energy decrease the model predicts, and
+:math:`K_s` may stay indefinite at a stable state. Below ``newton_below`` each step first tries Newton's step with
+the full tangent (held to the radius) and keeps it when the residual norm falls to ``newton_decrease`` of its value:
+there the merit is the residual, whose root is the equilibrium whatever the symmetry. The residual is always the
+undamped one: converged means :math:`\lVert R_f\rVert \le
 \max(\text{atol}, \text{rtol}\cdot f_\text{ref})` (the reactions' and loads' scale, as Newton).
 """
 
@@ -88,6 +93,11 @@ class TrustRegionOptions:
         one (a local Levenberg-Marquardt term :math:`s_i D_i` added to :math:`H + \alpha D`; the equilibrium does not
         depend on it), and the radius is cut only to 0.7 of the step; after each accepted step the local shifts fall
         by ``local_decay`` (below ``min_shift``: zero). ``local_shift`` 0: off (every rejection halves the radius).
+    newton_below, newton_decrease : float
+        Below the relative residual ``newton_below`` (0: never) a step is first tried as Newton's with the full
+        tangent, scaled into the radius, and kept when the residual norm falls below ``newton_decrease`` times its
+        value (module docstring); a failed try is rewound and not repeated until the residual has halved or ten steps
+        have passed.
     rtol, atol : float
         Converged when :math:`\lVert R_f\rVert \le \max(\text{atol}, \text{rtol}\,f_\text{ref})`.
     max_steps : int
@@ -108,6 +118,8 @@ class TrustRegionOptions:
     eta: float = 0.01
     local_shift: float = 0.1
     local_decay: float = 0.5
+    newton_below: float = 0.0
+    newton_decrease: float = 0.5
     rtol: float = 1e-6
     atol: float = 0.0
     max_steps: int = 500
@@ -127,6 +139,9 @@ class TrustRegionOptions:
         if not (math.isfinite(self.local_shift) and self.local_shift >= 0.0) or not 0.0 < self.local_decay <= 1.0:
             raise ValueError("TrustRegionOptions: need local_shift >= 0 and 0 < local_decay <= 1; got "
                              f"{self.local_shift!r}, {self.local_decay!r}")
+        if not (math.isfinite(self.newton_below) and self.newton_below >= 0.0) or not 0.0 < self.newton_decrease < 1.0:
+            raise ValueError("TrustRegionOptions: need newton_below >= 0 and 0 < newton_decrease < 1; got "
+                             f"{self.newton_below!r}, {self.newton_decrease!r}")
         if not 0.0 < self.eta < 0.25:
             raise ValueError(f"TrustRegionOptions.eta must lie in (0, 0.25); got {self.eta!r}")
         if self.max_strain_increment is not None and not (math.isfinite(self.max_strain_increment)
@@ -157,7 +172,11 @@ class TrustRegionStep:
 
 @dataclass
 class TrustRegionResult:
-    """The accepted steps (residual norms, energy changes, ratios, shifts, largest nodal motions) and the last state."""
+    """The accepted steps (residual norms, energy changes, ratios, shifts, largest nodal motions) and the last state.
+
+    ``newton_tries``: full-tangent Newton steps tried below ``newton_below`` (``newton_steps`` counts the kept ones, and
+    those of the trust region itself); ``negative_eigenvalues``: of :math:`K_s` at the converged state (PARDISO's
+    inertia; None where not measured). A kept Newton try's energy change is the trapezoidal work of the residual."""
 
     u: np.ndarray
     load_factor: float
@@ -167,10 +186,12 @@ class TrustRegionResult:
     shifts: list[float] = field(default_factory=list)
     largest_increments: list[float] = field(default_factory=list)
     newton_steps: int = 0
+    newton_tries: int = 0
     rejected: int = 0
     factorizations: int = 0
     converged: bool = False
     relative_residual: float = math.inf
+    negative_eigenvalues: int | None = None
     timings: dict[str, float] = field(default_factory=lambda: {"assembly": 0.0, "solve": 0.0})
 
 
@@ -287,10 +308,30 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
     local = np.zeros(n)  # local shifts s_i (relative to D)
     space = problem.space
     bar = tqdm(total=opts.max_steps, disable=not progress, desc="trust region", leave=False)
+    retry_below, retry_after = math.inf, 0  # when a failed Newton try may be repeated
+
+    def record(step, work, ratio, shift_taken, largest, newton) -> None:
+        result.u, result.relative_residual = u, relative
+        result.newton_steps += newton
+        for name, value in (("residuals", norm), ("energy_changes", work), ("ratios", ratio),
+                            ("shifts", shift_taken), ("largest_increments", largest)):
+            getattr(result, name).append(value)
+        if verbose:
+            print(f"step {step} |R|={norm:.3e} rel={relative:.3e} dPi={work:.3e} rho={ratio:.3f} "
+                  f"shift={shift_taken:.3g} max|du|={largest:.3g} radius={radius:.3g}{' newton' if newton else ''}",
+                  flush=True)
+        if not bar.disable:
+            bar.update(1)
+            bar.set_postfix(rel=f"{relative:.1e}", shift=f"{shift:.1e}", radius=f"{radius:.2g}")
+        event = TrustRegionStep(problem, step, t, u, norm, relative, work, ratio, shift, radius)
+        for callback in callbacks:
+            callback(event)
+
     try:
         while True:
             if relative <= opts.rtol or norm <= opts.atol:
                 result.converged = True
+                result.negative_eigenvalues = _negative_eigenvalues(solvers[1], problem, tangent, result)
                 break
             if len(result.residuals) >= opts.max_steps:
                 raise _give_up(result, f"{opts.max_steps} steps without converging")
@@ -299,6 +340,23 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             step = len(result.residuals) + 1
             clock = time.perf_counter()
             K = problem.tangent_matrix(tangent)
+            if relative <= min(opts.newton_below, retry_below) and step >= retry_after:
+                result.newton_tries += 1
+                tried = _newton_try(problem, solvers[2], K, residual, u, t, step, radius, norm, opts, result)
+                if tried is None:
+                    retry_below, retry_after = 0.5 * relative, step + 10
+                    if verbose:
+                        print(f"  Newton try at step {step} did not lower |R| to {opts.newton_decrease:g} of "
+                              f"{norm:.3e}", flush=True)
+                else:
+                    problem.commit()
+                    p, residual, tangent, work, largest = tried
+                    u = u + p
+                    norm = float(np.linalg.norm(residual[free]))
+                    relative = norm / reference_force(problem, residual, fixed)
+                    retry_below = math.inf
+                    record(step, work, math.nan, 0.0, largest, True)
+                    continue
             symmetric_K = (0.5 * (K + K.T)).tocsr()
             H = step_matrix(problem, tangent, opts.project) if opts.project else symmetric_K
             scale = np.abs(H.diagonal())
@@ -382,15 +440,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                 result.timings["assembly"] += time.perf_counter() - clock
             norm = float(np.linalg.norm(residual[free]))
             relative = norm / reference_force(problem, residual, fixed)
-            result.u, result.relative_residual = u, relative
-            result.newton_steps += newton
-            for name, value in (("residuals", norm), ("energy_changes", work), ("ratios", ratio),
-                                ("shifts", 0.0 if newton else shift), ("largest_increments", largest)):
-                getattr(result, name).append(value)
-            if verbose:
-                print(f"step {step} |R|={norm:.3e} rel={relative:.3e} dPi={work:.3e} rho={ratio:.3f} "
-                      f"shift={0.0 if newton else shift:.3g} max|du|={largest:.3g} radius={radius:.3g}"
-                      f"{' newton' if newton else ''}", flush=True)
+            shift_taken = 0.0 if newton else shift
             if ratio > 0.75:
                 shift = 0.0 if shift / 10.0 < opts.min_shift else shift / 10.0
                 if factor < 1.0:
@@ -398,15 +448,54 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             elif ratio < 0.25:
                 shift = min(max(2.0 * shift, opts.min_shift), opts.max_shift)
                 radius = max(0.5 * largest, opts.min_radius)
-            if not bar.disable:
-                bar.update(1)
-                bar.set_postfix(rel=f"{relative:.1e}", shift=f"{shift:.1e}", radius=f"{radius:.2g}")
-            event = TrustRegionStep(problem, step, t, u, norm, relative, work, ratio, shift, radius)
-            for callback in callbacks:
-                callback(event)
+            record(step, work, ratio, shift_taken, largest, newton)
     finally:
         bar.close()
     return result
+
+
+def _newton_try(problem, solver, K, residual, u, t, step, radius, norm, opts, result):
+    """Newton's step with the full tangent, scaled into ``radius``: (step, residual, tangent, trapezoidal work,
+    largest nodal motion) when the residual norm falls below ``newton_decrease * norm``, else None (rewound)."""
+    free, space = problem.pattern.free, problem.space
+    clock = time.perf_counter()
+    try:
+        _factorize(solver, K, result)
+        direction = solver.solve(-residual[free])
+    except np.linalg.LinAlgError:
+        return None
+    finally:
+        result.timings["solve"] += time.perf_counter() - clock
+    if not np.all(np.isfinite(direction)):
+        return None
+    p = np.zeros_like(u)
+    p[free] = direction
+    largest = float(np.linalg.norm(p[: space.n_u].reshape(-1, space.dim), axis=1).max(initial=0.0))
+    if largest > radius:
+        p *= radius / largest
+        largest = radius
+    clock = time.perf_counter()
+    try:
+        trial, tangent = problem.assemble(u + p, t, tangent=True, step=step)
+    except NonPositiveJacobianError:
+        trial = None
+    result.timings["assembly"] += time.perf_counter() - clock
+    if trial is None or not np.all(np.isfinite(trial)) or \
+            np.linalg.norm(trial[free]) > opts.newton_decrease * norm:
+        problem.rewind()
+        return None
+    return p, trial, tangent, 0.5 * float((residual[free] + trial[free]) @ p[free]), largest
+
+
+def _negative_eigenvalues(solver, problem, tangent, result) -> int | None:
+    """The number of negative eigenvalues of the free-dof :math:`K_s` (None where the backend gives no inertia)."""
+    K = problem.tangent_matrix(tangent)
+    try:
+        _factorize(solver, (0.5 * (K + K.T)).tocsr(), result)
+    except (np.linalg.LinAlgError, RuntimeError):
+        return None
+    inertia = solver.inertia()
+    return None if inertia is None else inertia[1]
 
 
 def _nodal_work(r_start, r_middle, r_end, step, free, space) -> np.ndarray:
