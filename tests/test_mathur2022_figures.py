@@ -161,7 +161,8 @@ def test_reproduce_full_writes_the_figures_of_the_last_state(setup, tmp_path, mo
     module = reproduce_module
 
     def stopped(setup, end, options, callbacks=(), progress=True, held=None):
-        assert held is not None and held.max_radius == setup.contact.max_penetration  # held load: the trust region
+        assert held is not None and held.radius == 0.25 * setup.contact.max_penetration  # held: the trust region
+        assert held.newton_below > 0.0
         return ClosureRun(load_factors=[0.0], iterations=[0], contact_pairs=[0],
                           u=np.zeros(setup.problem.space.n_dofs), error="stopped for the test")
 

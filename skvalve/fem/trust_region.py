@@ -263,13 +263,17 @@ class _Attempt(Exception):
 def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegionOptions | None = None, *,
                  edges: np.ndarray | None = None, rest_lengths: np.ndarray | None = None,
                  callbacks: Sequence[Callable[[TrustRegionStep], None]] = (), progress: bool = True,
-                 verbose: bool = False, relax: Callable[[np.ndarray, float], tuple] | None = None
-                 ) -> TrustRegionResult:
+                 verbose: bool = False, relax: Callable[[np.ndarray, float], tuple] | None = None,
+                 limit: Callable[[np.ndarray, np.ndarray], float] | None = None) -> TrustRegionResult:
     """Relax ``problem`` at the held load factor ``t`` from ``u0`` to an equilibrium (module docstring).
 
     ``relax``: a :class:`~skvalve.fem.block_relaxation.BlockRelaxation` (``relax(u, t) -> (u, result)``, the result
     with ``iterations`` and ``energy_change``) run before the first step and after each accepted one (e.g. the
     chordae branch points brought to equilibrium with the rest held); its energy change is added to the step's.
+
+    ``limit``: ``limit(u, p) -> f`` in (0, 1], the fraction of a step ``p`` (already held to the radius) that may be
+    taken (e.g. :func:`~skvalve.fem.contact_clearance.clearance_fraction`: no node carried through a contact sheet);
+    it applies to Newton tries too.
 
     ``edges``/``rest_lengths`` as in :func:`~skvalve.fem.ptc.pseudo_transient`. Returns a :class:`TrustRegionResult`
     with ``converged`` set; raises :class:`~skvalve.fem.errors.ConvergenceError` (``error.last_state``: the result up
@@ -342,7 +346,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             K = problem.tangent_matrix(tangent)
             if relative <= min(opts.newton_below, retry_below) and step >= retry_after:
                 result.newton_tries += 1
-                tried = _newton_try(problem, solvers[2], K, residual, u, t, step, radius, norm, opts, result)
+                tried = _newton_try(problem, solvers[2], K, residual, u, t, step, radius, norm, opts, result, limit)
                 if tried is None:
                     retry_below, retry_after = 0.5 * relative, step + 10
                     if verbose:
@@ -385,6 +389,8 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                 change = float(np.max(_stretch_changes(edges[2], u, u + factor * p, edges[0], edges[1])))
                 if change > opts.max_strain_increment:
                     factor *= opts.max_strain_increment / change
+            if limit is not None:
+                factor *= _limited(limit, u, factor * p)
             p *= factor
             largest *= factor
             r_free, p_free = residual[free], p[free]
@@ -454,7 +460,14 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
     return result
 
 
-def _newton_try(problem, solver, K, residual, u, t, step, radius, norm, opts, result):
+def _limited(limit, u: np.ndarray, p: np.ndarray) -> float:
+    fraction = float(limit(u, p))
+    if not 0.0 < fraction <= 1.0:
+        raise ValueError(f"trust region: the step limit must return a fraction in (0, 1]; got {fraction!r}")
+    return fraction
+
+
+def _newton_try(problem, solver, K, residual, u, t, step, radius, norm, opts, result, limit):
     """Newton's step with the full tangent, scaled into ``radius``: (step, residual, tangent, trapezoidal work,
     largest nodal motion) when the residual norm falls below ``newton_decrease * norm``, else None (rewound)."""
     free, space = problem.pattern.free, problem.space
@@ -474,6 +487,10 @@ def _newton_try(problem, solver, K, residual, u, t, step, radius, norm, opts, re
     if largest > radius:
         p *= radius / largest
         largest = radius
+    if limit is not None:
+        fraction = _limited(limit, u, p)
+        p *= fraction
+        largest *= fraction
     clock = time.perf_counter()
     try:
         trial, tangent = problem.assemble(u + p, t, tangent=True, step=step)

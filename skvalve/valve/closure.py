@@ -23,6 +23,7 @@ import math
 import resource
 import time
 from dataclasses import dataclass, field, replace
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +31,7 @@ import numpy as np
 from ..fem.amplitudes import GeometricRamp, smooth_step_polynomial
 from ..fem.block_relaxation import BlockRelaxation
 from ..fem.contact import SurfaceContact
+from ..fem.contact_clearance import clearance_fraction
 from ..fem.damping import ViscousDamping, lumped_volume, undamped_residual
 from ..fem.newton import StepEvent, solve
 from ..fem.problem import Problem
@@ -389,7 +391,8 @@ def relax_closure(setup: ClosureSetup, end: float,
         if held is not None:
             hubs = hub_relaxation(setup) if setup.model is not None else None
             result = trust_region(setup.problem, end, u0, held, edges=edges, rest_lengths=rest_lengths,
-                                  callbacks=[record, *callbacks], progress=progress, verbose=verbose, relax=hubs)
+                                  callbacks=[record, *callbacks], progress=progress, verbose=verbose, relax=hubs,
+                                  limit=partial(clearance_fraction, setup.contact))
             add_effort(result)
             run.negative_eigenvalues = result.negative_eigenvalues
     except Exception as err:  # noqa: BLE001 - a failed closure is a result to report, with its last state
@@ -413,13 +416,19 @@ def relax_closure(setup: ClosureSetup, end: float,
 HELD_NEWTON_BELOW = 1e-4
 
 
+#: largest nodal motion (mm) of one held step; what keeps nodes from passing through a sheet is the clearance limit
+HELD_MAX_RADIUS = 1.0
+
+
 def held_options(setup: ClosureSetup, **overrides) -> TrustRegionOptions:
-    """Trust-region controls for the held load of a valve closure: steps of at most the contact search depth on any
-    node (a penalty energy ignores a node past that depth, so an energy-following step longer than it could carry a
-    node through a sheet), first radius a quarter of it, and ``overrides`` (e.g. ``rtol``, ``atol``)."""
+    """Trust-region controls for the held load of a valve closure: first radius a quarter of the contact search depth,
+    steps of at most ``HELD_MAX_RADIUS`` (or the depth, if larger) on any node, and ``overrides`` (e.g. ``rtol``,
+    ``atol``). :func:`relax_closure` also limits each step by the contact clearance
+    (:func:`~skvalve.fem.contact_clearance.clearance_fraction`): a penalty energy ignores a node past the search depth,
+    so a step that moved a node further than that relative to a nearby sheet could carry it through unseen."""
     depth = setup.contact.max_penetration
-    return TrustRegionOptions(**{"radius": 0.25 * depth, "max_radius": depth, "newton_below": HELD_NEWTON_BELOW,
-                                 **overrides})
+    return TrustRegionOptions(**{"radius": 0.25 * depth, "max_radius": max(depth, HELD_MAX_RADIUS),
+                                 "newton_below": HELD_NEWTON_BELOW, **overrides})
 
 
 def hub_relaxation(setup: ClosureSetup) -> BlockRelaxation | None:
