@@ -49,7 +49,7 @@ def test_a_rigid_motion_is_free_and_an_approach_is_held_to_the_depth():
     step = np.zeros_like(u)
     step[2::3][X[2] > 1.0 + 0.5 * GAP] = -1.0  # the top block 1.0 down: through the bottom one
     fraction = clearance_fraction(contact, u, step)
-    # the face triangles' diagonal (0.71) exceeds the gap, so the bound leaves the depth: 0.1 of the 1.0
+    # a triangle's centroid-corner reach (0.37) exceeds the gap, so the distance bound is 0 and the depth is left
     assert fraction == pytest.approx(DEPTH)
     assert fraction * 1.0 <= GAP + DEPTH  # the moved face ends at most the depth through the other
     assert clearance_fraction(contact, u, 0.04 * step) == 1.0  # shorter than half the depth: no pair can pass it

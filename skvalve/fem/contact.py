@@ -232,6 +232,16 @@ class SurfaceContact(Term):
         self._assembled_u: np.ndarray | None = None
         self._committed_u: np.ndarray | None = None  # blended contact: the state whose normals give the facing
 
+    @property
+    def excluded_keys(self) -> np.ndarray:
+        """Sorted keys ``node * n_triangles + triangle`` of the pairs never in contact (topological neighbours)."""
+        return self._excluded
+
+    @property
+    def reference_centroids(self) -> np.ndarray:
+        """(n_triangles, 3) triangle centroids in the reference (``exclude_within`` is measured from them)."""
+        return self._reference_centroids
+
     # ------------------------------------------------------------------ search
     def active_pairs(self, u: np.ndarray) -> ActivePairs:
         """Node-triangle pairs in contact at displacement ``u`` (module docstring for the rules)."""
