@@ -314,7 +314,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
     bar = tqdm(total=opts.max_steps, disable=not progress, desc="trust region", leave=False)
     retry_below, retry_after = math.inf, 0  # when a failed Newton try may be repeated
 
-    def record(step, work, ratio, shift_taken, largest, newton) -> None:
+    def record(step, work, ratio, shift_taken, largest, newton, held_by) -> None:
         result.u, result.relative_residual = u, relative
         result.newton_steps += newton
         for name, value in (("residuals", norm), ("energy_changes", work), ("ratios", ratio),
@@ -322,8 +322,8 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             getattr(result, name).append(value)
         if verbose:
             print(f"step {step} |R|={norm:.3e} rel={relative:.3e} dPi={work:.3e} rho={ratio:.3f} "
-                  f"shift={shift_taken:.3g} max|du|={largest:.3g} radius={radius:.3g}{' newton' if newton else ''}",
-                  flush=True)
+                  f"shift={shift_taken:.3g} max|du|={largest:.3g} radius={radius:.3g} held by {held_by}"
+                  f"{' newton' if newton else ''}", flush=True)
         if not bar.disable:
             bar.update(1)
             bar.set_postfix(rel=f"{relative:.1e}", shift=f"{shift:.1e}", radius=f"{radius:.2g}")
@@ -359,7 +359,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                     norm = float(np.linalg.norm(residual[free]))
                     relative = norm / reference_force(problem, residual, fixed)
                     retry_below = math.inf
-                    record(step, work, math.nan, 0.0, largest, True)
+                    record(step, work, math.nan, 0.0, largest, True, "newton try")
                     continue
             symmetric_K = (0.5 * (K + K.T)).tocsr()
             H = step_matrix(problem, tangent, opts.project) if opts.project else symmetric_K
@@ -385,12 +385,17 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             moves = np.linalg.norm(p[: space.n_u].reshape(-1, space.dim), axis=1)
             largest = float(moves.max(initial=0.0))
             factor = min(1.0, radius / largest) if largest > 0.0 else 1.0
+            held_by = "radius" if factor < 1.0 else "none"  # what shortened the step (verbose output)
             if edges is not None and opts.max_strain_increment is not None and edges[0].size:
                 change = float(np.max(_stretch_changes(edges[2], u, u + factor * p, edges[0], edges[1])))
                 if change > opts.max_strain_increment:
                     factor *= opts.max_strain_increment / change
+                    held_by = "stretch"
             if limit is not None:
-                factor *= _limited(limit, u, factor * p)
+                fraction = _limited(limit, u, factor * p)
+                if fraction < 1.0:
+                    factor *= fraction
+                    held_by = "limit"
             p *= factor
             largest *= factor
             r_free, p_free = residual[free], p[free]
@@ -454,7 +459,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             elif ratio < 0.25:
                 shift = min(max(2.0 * shift, opts.min_shift), opts.max_shift)
                 radius = max(0.5 * largest, opts.min_radius)
-            record(step, work, ratio, shift_taken, largest, newton)
+            record(step, work, ratio, shift_taken, largest, newton, held_by)
     finally:
         bar.close()
     return result
