@@ -221,6 +221,12 @@ def main() -> int:
               f"{measures.orifice['mid']:.1f}, leaflets {measures.leaflet_area['mid']:.1f}, coaptation "
               f"{measures.coaptation_area:.1f}; centre max principal Cauchy stress "
               + ", ".join(f"{name} {1e3 * value:.2f}" for name, value in measures.centre_stress.items()))
+        pairs = setup.contact.active_pairs(run.u)
+        depth = setup.contact.max_penetration
+        deepest = np.zeros(setup.problem.space.n_scalar)
+        np.maximum.at(deepest, pairs.node, np.maximum(-pairs.gap, 0.0))
+        print(f"contact overlap: deepest {deepest.max(initial=0.0):.3g} mm of the search depth {depth:.3g} mm; nodes "
+              f"deeper than half of it: {int((deepest > 0.5 * depth).sum())}")
         mesh = setup.model.mesh
         corners = hex_corner_jacobians(mesh.p.T + run.u[: setup.problem.space.n_u].reshape(-1, 3),
                                        mesh.t.T[:, np.argsort(ABAQUS_TO_SKFEM_HEX)])  # det(dx/dxi) at each corner
