@@ -344,7 +344,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             step = len(result.residuals) + 1
             clock = time.perf_counter()
             K = problem.tangent_matrix(tangent)
-            if relative <= min(opts.newton_below, retry_below) and step >= retry_after:
+            if relative <= opts.newton_below and (relative <= retry_below or step >= retry_after):
                 result.newton_tries += 1
                 tried = _newton_try(problem, solvers[2], K, residual, u, t, step, radius, norm, opts, result, limit)
                 if tried is None:
