@@ -1,5 +1,5 @@
 """The contact clearance limit (:mod:`skvalve.fem.contact_clearance`): it lets a surface move rigidly as far as it
-likes, holds an approaching face to the search depth, and keeps the trust region from carrying a block through
+likes, holds an approaching face to half the search depth, and keeps the trust region from carrying a block through
 another, which it does without it."""
 
 from functools import partial
@@ -49,10 +49,10 @@ def test_a_rigid_motion_is_free_and_an_approach_is_held_to_the_depth():
     step = np.zeros_like(u)
     step[2::3][X[2] > 1.0 + 0.5 * GAP] = -1.0  # the top block 1.0 down: through the bottom one
     fraction = clearance_fraction(contact, u, step)
-    # a triangle's centroid-corner reach (0.37) exceeds the gap, so the distance bound is 0 and the depth is left
-    assert fraction == pytest.approx(DEPTH)
-    assert fraction * 1.0 <= GAP + DEPTH  # the moved face ends at most the depth through the other
-    assert clearance_fraction(contact, u, 0.04 * step) == 1.0  # shorter than half the depth: no pair can pass it
+    # a triangle's centroid-corner reach (0.37) exceeds the gap, so the distance bound is 0 and half the depth is left
+    assert fraction == pytest.approx(0.5 * DEPTH)
+    assert fraction * 1.0 <= GAP + 0.5 * DEPTH  # the moved face ends at most half the depth through the other
+    assert clearance_fraction(contact, u, 0.02 * step) == 1.0  # under a quarter of the depth: no pair can pass half
 
 
 def test_the_limit_keeps_a_long_step_from_carrying_a_block_through_another():
