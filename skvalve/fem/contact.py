@@ -232,15 +232,13 @@ class SurfaceContact(Term):
         self._assembled_u: np.ndarray | None = None
         self._committed_u: np.ndarray | None = None  # blended contact: the state whose normals give the facing
 
-    @property
-    def excluded_keys(self) -> np.ndarray:
-        """Sorted keys ``node * n_triangles + triangle`` of the pairs never in contact (topological neighbours)."""
-        return self._excluded
-
-    @property
-    def reference_centroids(self) -> np.ndarray:
-        """(n_triangles, 3) triangle centroids in the reference (``exclude_within`` is measured from them)."""
-        return self._reference_centroids
+    def may_contact(self, node: np.ndarray, triangle: np.ndarray) -> np.ndarray:
+        """(n,) bool: the node-triangle pairs that are not excluded (topological neighbours, or closer than
+        ``exclude_within`` in the reference); the search and :mod:`~skvalve.fem.contact_clearance` both use it."""
+        keep = ~np.isin(node * self.surface.triangles.shape[0] + triangle, self._excluded)
+        if self.exclude_within > 0.0:
+            keep &= np.linalg.norm(self.X[node] - self._reference_centroids[triangle], axis=1) >= self.exclude_within
+        return keep
 
     # ------------------------------------------------------------------ search
     def active_pairs(self, u: np.ndarray) -> ActivePairs:
@@ -260,9 +258,7 @@ class SurfaceContact(Term):
             return _no_pairs()
         node = np.repeat(slaves, counts)
         triangle = np.fromiter((j for item in lists for j in item), dtype=np.int64, count=int(counts.sum()))
-        keep = ~np.isin(node * tri.shape[0] + triangle, self._excluded, assume_unique=False)
-        if self.exclude_within > 0.0:
-            keep &= np.linalg.norm(self.X[node] - self._reference_centroids[triangle], axis=1) >= self.exclude_within
+        keep = self.may_contact(node, triangle)
         node, triangle = node[keep], triangle[keep]
         c = corners[triangle]
         m = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])

@@ -56,14 +56,7 @@ def clearance_fraction(contact: SurfaceContact, u: np.ndarray, p: np.ndarray) ->
     node, triangle = nodes[near["i"]], near["j"].astype(np.int64)
     distance = np.maximum(near["v"] - reach[triangle], 0.0)
     keep = distance < 2.0 * largest
-    keys = node * triangles.shape[0] + triangle
-    excluded = contact.excluded_keys
-    if excluded.size:
-        position = np.minimum(np.searchsorted(excluded, keys), excluded.size - 1)
-        keep &= excluded[position] != keys
-    if contact.exclude_within > 0.0:
-        keep &= np.linalg.norm(contact.X[node] - contact.reference_centroids[triangle], axis=1) \
-            >= contact.exclude_within
+    keep[keep] = contact.may_contact(node[keep], triangle[keep])
     node, triangle, distance = node[keep], triangle[keep], distance[keep]
     if node.size == 0:
         return 1.0
