@@ -618,7 +618,10 @@ if HAVE_DATA:
 #   positive semidefinite part plus an inertia-corrected shift, and a step is kept when the energy falls by a fair
 #   share of what its quadratic model predicts. The follower pressure on leaflets with free edges is not
 #   conservative, so close to equilibrium that energy is only approximate; below a relative residual of 1e-4 each step
-#   first tries Newton's step with the full tangent and keeps it when the residual halves. It prints all Table 2–3
+#   first tries Newton's step with the full tangent and keeps it when the residual halves. Every step, damped or not,
+#   is cut where it would carry a contact node deeper than half the search depth through a leaflet
+#   (`skvalve.fem.contact_clearance`: the gap of each near node-triangle pair followed along the step; sliding is
+#   free): past that depth the penalty fades out and would let the node through. It prints all Table 2–3
 #   rows of the diseased column, with a VTU/PVD
 #   series for ParaView. The load-stepped Newton closure of this section
 #   (`run_closure`, soft chords, converged damped steps) stalls in the tethering stage of the whole valve.

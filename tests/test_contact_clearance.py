@@ -11,6 +11,8 @@ import skfem
 from skvalve.fem import HyperelasticTerm, MaterialRegions, Problem, Space
 from skvalve.fem.contact import ContactSurface, SurfaceContact
 from skvalve.fem.contact_clearance import clearance_fraction
+from skvalve.fem.damping import lumped_volume
+from skvalve.fem.ptc import PseudoTransientOptions, pseudo_transient
 from skvalve.fem.trust_region import TrustRegionOptions, trust_region
 from skvalve.materials import NeoHookean
 
@@ -41,18 +43,36 @@ def _overlap(problem, u) -> float:
     return float(z[np.isclose(X[2], 1.0)].max() - z[np.isclose(X[2], 1.0 + GAP)].min())
 
 
-def test_a_rigid_motion_is_free_and_an_approach_is_held_to_the_depth():
+def test_a_rigid_motion_is_free_and_an_approach_is_held_to_half_the_depth():
     problem, contact = _blocks()
     X = problem.space.dof_coordinates
     u = np.zeros(problem.space.n_dofs)
     assert clearance_fraction(contact, u, np.tile([3.0, -2.0, 5.0], X.shape[1])) == 1.0  # no relative motion
     step = np.zeros_like(u)
     step[2::3][X[2] > 1.0 + 0.5 * GAP] = -1.0  # the top block 1.0 down: through the bottom one
-    fraction = clearance_fraction(contact, u, step)
-    # a triangle's centroid-corner reach (0.37) exceeds the gap, so the distance bound is 0 and half the depth is left
-    assert fraction == pytest.approx(0.5 * DEPTH)
-    assert fraction * 1.0 <= GAP + 0.5 * DEPTH  # the moved face ends at most half the depth through the other
-    assert clearance_fraction(contact, u, 0.02 * step) == 1.0  # under a quarter of the depth: no pair can pass half
+    # the faces are parallel, so the gap is GAP - f: it reaches -DEPTH/2 at f = GAP + DEPTH/2
+    assert clearance_fraction(contact, u, step) == pytest.approx(GAP + 0.5 * DEPTH, abs=1e-8)
+    assert clearance_fraction(contact, u, 0.2 * step) == 1.0  # ends 0.0 apart
+
+
+def test_a_close_node_slides_freely_and_goes_no_deeper():
+    """The top block already 0.04 through the bottom one (under half the depth) may slide 1.0 sideways in one step
+    (a bound on the relative motion alone would allow 0.05); a node pushed 0.7 of the depth through may come out but
+    not go deeper."""
+    problem, contact = _blocks()
+    X = problem.space.dof_coordinates
+    top = X[2] > 1.0 + 0.5 * GAP
+    u = np.zeros(problem.space.n_dofs)
+    u[2::3][top] = -(GAP + 0.04)
+    slide = np.zeros_like(u)
+    slide[0::3][top] = 1.0
+    assert clearance_fraction(contact, u, slide) == 1.0
+    down = np.zeros_like(u)
+    down[2::3][top] = -1.0
+    assert clearance_fraction(contact, u, down) == pytest.approx(0.5 * DEPTH - 0.04, abs=1e-8)
+    u[2::3][top] = -(GAP + 0.7 * DEPTH)
+    assert clearance_fraction(contact, u, -down) == 1.0  # out: free
+    assert clearance_fraction(contact, u, 0.01 * down) < 1e-6  # deeper: not at all
 
 
 def test_the_limit_keeps_a_long_step_from_carrying_a_block_through_another():
@@ -74,6 +94,36 @@ def test_the_limit_keeps_a_long_step_from_carrying_a_block_through_another():
     assert 0.0 < _overlap(problem, limited.u) < 0.1 * DEPTH
     np.testing.assert_allclose(limited.u, capped.u, atol=1e-9)
     assert len(limited.residuals) < len(capped.residuals)
+
+
+def test_the_limit_keeps_a_pseudo_transient_step_from_carrying_a_block_through_another():
+    """One lightly damped pseudo-step of the whole push (0.45, ramped with the load factor) carries the top block
+    through the bottom one; with the limit the rejected steps are cut until no node ends deeper than half the depth,
+    and Ψtc ends at the same contact state as the trust region with steps of at most half the depth."""
+    options = PseudoTransientOptions(damping=1e-3, first_step=1.0, max_load_step=1.0, rtol=1e-10, atol=1e-12,
+                                     max_increment=None, max_strain_increment=None)
+    problem, _ = _blocks()
+    loose = pseudo_transient(problem, lumped_volume(problem.space), 1.0, options, progress=False)
+    assert _overlap(problem, loose.u) > 2.0 * DEPTH  # tunnelled
+    problem, contact = _blocks()
+    seen = []
+
+    def watched(u, p):
+        fraction = clearance_fraction(contact, u, p)
+        seen.append(fraction)
+        return fraction
+
+    limited = pseudo_transient(problem, lumped_volume(problem.space), 1.0, options, progress=False, limit=watched)
+    problem, _ = _blocks()
+    capped = trust_region(problem, 1.0, np.zeros(problem.space.n_dofs),
+                          TrustRegionOptions(rtol=1e-10, radius=0.04, max_radius=0.5 * DEPTH, solver="scipy",
+                                             max_steps=2000), progress=False)
+    assert limited.converged and limited.rejected >= 1 and min(seen) < 1.0
+    assert 0.0 < _overlap(problem, limited.u) < 0.1 * DEPTH
+    np.testing.assert_allclose(limited.u, capped.u, atol=1e-8)
+    problem, _ = _blocks()
+    with pytest.raises(ValueError, match="fraction in"):
+        pseudo_transient(problem, lumped_volume(problem.space), 1.0, options, progress=False, limit=lambda u, p: 2.0)
 
 
 def test_a_limit_outside_zero_to_one_is_refused():

@@ -267,7 +267,7 @@ class SurfaceContact(Term):
         if self.blend > 0.0:
             return self._blended_candidates(x, node, triangle, gap, c)
         ok = (gap < 0.0) & (gap > -self.max_penetration)
-        ok &= np.einsum("ij,ij->i", self._node_normals(x)[node], normal) < -self.opposing
+        ok &= np.einsum("ij,ij->i", self.node_normals(x)[node], normal) < -self.opposing
         node, triangle, gap, c, normal = node[ok], triangle[ok], gap[ok], c[ok], normal[ok]
         weights = barycentric(x[node], c)
         inside = weights.min(axis=1)
@@ -308,7 +308,7 @@ class SurfaceContact(Term):
         x0 = x if self._committed_u is None else self.X + self._committed_u[: self.space.n_u].reshape(-1, 3)
         c0 = x0[self.surface.triangles[triangle]]
         m0 = np.cross(c0[:, 1] - c0[:, 0], c0[:, 2] - c0[:, 0])
-        cosine = np.einsum("ij,ij->i", self._node_normals(x0)[node], m0 / np.linalg.norm(m0, axis=1, keepdims=True))
+        cosine = np.einsum("ij,ij->i", self.node_normals(x0)[node], m0 / np.linalg.norm(m0, axis=1, keepdims=True))
         facing = smooth_step((-cosine - self.opposing) / FACING_BAND)[0]
         ok = facing > 0.0
         return ActivePairs(node[ok], triangle[ok], gap[ok], weights[ok], facing[ok])
@@ -351,7 +351,9 @@ class SurfaceContact(Term):
                              f"(-1 for none); got shape {previous.shape}")
         self._previous[:] = previous
 
-    def _node_normals(self, x: np.ndarray) -> np.ndarray:
+    def node_normals(self, x: np.ndarray) -> np.ndarray:
+        """Unit normal (n_nodes, 3) of each surface node at positions ``x``: the mean of its faces' (zero off the
+        surface)."""
         Q = x[self.surface.quads]
         face = np.cross(Q[:, 2] - Q[:, 0], Q[:, 3] - Q[:, 1])
         normals = np.zeros_like(x)
@@ -455,7 +457,7 @@ class SurfaceContact(Term):
         ``force``: the term's internal force (n_u,) at ``u`` (default: that of the last assembly)."""
         force = self.last_force if force is None else force
         x = self.X + u[: self.space.n_u].reshape(-1, 3)
-        normals = self._node_normals(x)
+        normals = self.node_normals(x)
         # ``force`` is the residual contribution (internal force): the contact acts on the node with -force
         normal_force = np.einsum("ij,ij->i", force.reshape(-1, 3), normals)
         pressure = np.zeros(self.space.n_scalar)

@@ -1,67 +1,122 @@
 r"""How far a step may carry a contact surface before a node could pass through a sheet: a step limit by clearance.
 
 A penalty energy that ignores overlaps past the search depth :math:`g_\max` lets a long step carry a node through a
-sheet unseen. Capping every node's motion at :math:`g_\max` prevents that, but it also holds back the parts of a
-structure that swing together, or are far from any other sheet (the thin 1.1 valve leaflets: 0.16 mm). This limit
-looks at relative motion instead. For a node :math:`i` of the surface and a triangle :math:`T` it may contact (not a
-topological neighbour, not excluded by reference distance: the pairs the contact search itself keeps), with
-:math:`c_T` the centroid and :math:`r_T` the largest centroid-corner distance,
+sheet unseen; worse, the blended penalty fades out over :math:`0.8\,g_\max < h < g_\max`
+(:mod:`~skvalve.fem.contact_blend`), where its energy *falls* with depth, so a node that reached the fade is pushed on
+through (the 1.0 valve's search depth, 0.50 mm, is more than its two-layer leaflets' thickness, 0.39 mm). Capping
+every node's motion at :math:`g_\max` prevents that, but it also holds back the parts of a structure that swing or
+slide together. This limit looks at what matters, pair by pair: for a node :math:`i` of the surface and a triangle
+:math:`T` it may contact (not a topological neighbour, not excluded by reference distance: the pairs the contact
+search itself keeps), with normals opposed and the node within the search depth (:math:`g_0 > -g_\max`), the gap
+:math:`g(f)` (:mod:`~skvalve.fem.contact_geometry`) is followed along the step :math:`f p`, and wherever the node's
+projection lies in the triangle's band (barycentric coordinates :math:`\ge -2\beta`) it must stay
 
 .. math::
 
-    d_{iT} = \max(0, \lvert x_i - c_T\rvert - r_T) \le \operatorname{dist}(x_i, T), \qquad
-    m_{iT} = \max_{v \in T} \lvert p_i - p_v\rvert ,
+    g(f) \ge \min\big(g_0, -\tfrac12 g_\max\big):
 
-a lower bound on the distance and an upper bound on the node's motion relative to any point of the triangle (which
-moves by a convex combination of its corners' motions). The step :math:`f p` brings the node at most
-:math:`\tfrac12 g_\max` past the triangle when :math:`f\,m_{iT} \le d_{iT} + \tfrac12 g_\max`: a node that was not
-past a face ends short of the deep fade-out of the blended penalty (from :math:`0.8\,g_\max` on), whose energy
-falls with depth, so it cannot cross that barrier in one step unseen by the energy test (the 1.0 valve's search depth,
-0.50 mm, is also more than its two-layer leaflets' thickness, 0.39 mm). The fraction of the step that may be taken is
-
-.. math::
-
-    f = \min\Big(1, \min_{iT} \frac{d_{iT} + \tfrac12 g_\max}{m_{iT}}\Big)
-
-over the pairs with :math:`d_{iT} < 2\max_k\lvert p_k\rvert` (no other pair can close its distance), found with
-``scipy.spatial.cKDTree.sparse_distance_matrix`` between the nodes and the centroids.
+a node may slide along a sheet and come out of it freely, but not go deeper than half the depth, or than it already
+is. So a node never reaches the fade-out from a state where it was shallower than half the depth, and the step's
+energy test sees every barrier. :math:`g(f)` is sampled at :math:`\max(8, 4 m/g_\max)` points (at most 64; :math:`m`
+the largest motion of a node relative to a triangle's corner), so that between samples a gap changes by about a
+quarter of the depth, and the first crossing is bisected. Only the pairs that can reach are followed: with
+:math:`c_T` the centroid, :math:`r_T` the largest centroid-corner distance and :math:`m_{iT} = \max_{v\in T}\lvert
+p_i - p_v\rvert` the node's largest motion relative to any point of the triangle (which moves by a convex
+combination of its corners' motions), a projection in the band lies within :math:`(1 + 6\beta) r_T` of the centroid,
+so a pair with :math:`\lvert x_i - c_T\rvert - m_{iT} > (1 + 6\beta) r_T + \tfrac34 g_\max` cannot cross; the others
+are found with ``scipy.spatial.cKDTree.sparse_distance_matrix`` between the nodes and the centroids.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from .contact import SurfaceContact
+from .contact_geometry import barycentric
 
 __all__ = ["clearance_fraction"]
 
+#: Samples along the step of a close pair's gap: at least this many ...
+MIN_SAMPLES = 8
+#: ... and at most this many.
+MAX_SAMPLES = 64
+#: Bisection steps on the first sampled crossing.
+BISECTIONS = 30
+#: A pair is followed if its node can come within the band's reach plus this many search depths of the centroid.
+SLACK = 0.75
+
 
 def clearance_fraction(contact: SurfaceContact, u: np.ndarray, p: np.ndarray) -> float:
-    """The largest fraction :math:`f \\le 1` of the step ``p`` from ``u`` (full dof vectors) that can carry no node
-    of ``contact``'s surface more than half its search depth through a triangle it may contact (module docstring)."""
+    """The largest fraction :math:`f \\le 1` of the step ``p`` from ``u`` (full dof vectors) that carries no node of
+    ``contact``'s surface deeper than half its search depth (or deeper than it is) through a triangle it may contact
+    (module docstring)."""
     n_u = contact.space.n_u
     nodes, triangles = contact.surface.nodes, contact.surface.triangles
     x = contact.X + u[:n_u].reshape(-1, 3)
     motion = p[:n_u].reshape(-1, 3)
     largest = float(np.linalg.norm(motion[nodes], axis=1).max(initial=0.0))
-    allowance = 0.5 * contact.max_penetration
-    if 2.0 * largest <= allowance:  # no pair's relative motion can pass the allowance
+    if largest == 0.0:
         return 1.0
+    depth = contact.max_penetration
+    band = -2.0 * max(contact.blend, contact.tolerance)
     corners = x[triangles]
     centroid = corners.mean(axis=1)
-    reach = np.linalg.norm(corners - centroid[:, None], axis=2).max(axis=1)
+    # a projection in the band lies within (1 - 3 band) r_T of the centroid
+    reach = (1.0 - 3.0 * band) * np.linalg.norm(corners - centroid[:, None], axis=2).max(axis=1) + SLACK * depth
     near = cKDTree(x[nodes]).sparse_distance_matrix(cKDTree(centroid), 2.0 * largest + float(reach.max()),
                                                     output_type="ndarray")
     node, triangle = nodes[near["i"]], near["j"].astype(np.int64)
-    distance = np.maximum(near["v"] - reach[triangle], 0.0)
+    distance = near["v"] - reach[triangle]
     keep = distance < 2.0 * largest
     keep[keep] = contact.may_contact(node[keep], triangle[keep])
     node, triangle, distance = node[keep], triangle[keep], distance[keep]
+    corner_ids = triangles[triangle]
+    relative = np.linalg.norm(motion[node][:, None, :] - motion[corner_ids], axis=2).max(axis=1)
+    reaching = relative > distance  # no other pair can end in its triangle's band within the depth
+    node, corner_ids, relative = node[reaching], corner_ids[reaching], relative[reaching]
     if node.size == 0:
         return 1.0
-    relative = np.linalg.norm(motion[node][:, None, :] - motion[triangles[triangle]], axis=2).max(axis=1)
-    bound = relative > distance + allowance
-    if not np.any(bound):
+    gap0, _ = _gap_and_band(x, motion, node, corner_ids, 0.0)
+    c = x[corner_ids]
+    opposed = np.einsum("ij,ij->i", contact.node_normals(x)[node], np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])) < 0
+    seen = opposed & (gap0 > -depth)
+    node, corner_ids, gap0 = node[seen], corner_ids[seen], gap0[seen]
+    if node.size == 0:
         return 1.0
-    return float(np.min((distance[bound] + allowance) / relative[bound]))
+    floor = np.minimum(gap0, -0.5 * depth)
+
+    def violated(f: np.ndarray, which: np.ndarray) -> np.ndarray:
+        gap, lam = _gap_and_band(x, motion, node[which], corner_ids[which], f)
+        return (gap < floor[which]) & (lam.min(axis=1) >= band)
+
+    samples = int(min(MAX_SAMPLES, max(MIN_SAMPLES, math.ceil(4.0 * float(relative.max()) / depth))))
+    crossing = np.full(node.size, np.inf)
+    everyone = np.arange(node.size)
+    for f in np.linspace(0.0, 1.0, samples + 1)[1:]:
+        open_pairs = everyone[np.isinf(crossing)]
+        hit = violated(np.full(open_pairs.size, f), open_pairs)
+        crossing[open_pairs[hit]] = f
+    which = everyone[np.isfinite(crossing)]
+    if which.size == 0:
+        return 1.0
+    high = crossing[which]
+    low = high - 1.0 / samples  # the last sample at which the pair was fine
+    for _ in range(BISECTIONS):
+        middle = 0.5 * (low + high)
+        hit = violated(middle, which)
+        high = np.where(hit, middle, high)
+        low = np.where(hit, low, middle)
+    return float(low.min())
+
+
+def _gap_and_band(x, motion, node, corner_ids, f):
+    """Gap (n,) and barycentric coordinates (n, 3) of each node over its triangle at ``x + f motion``."""
+    f = np.asarray(f, dtype=float).reshape(-1, 1)
+    xs = x[node] + f * motion[node]
+    c = x[corner_ids] + f[:, :, None] * motion[corner_ids]
+    m = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
+    normal = m / np.linalg.norm(m, axis=1, keepdims=True)
+    return np.einsum("ij,ij->i", xs - c[:, 0], normal), barycentric(xs, c)

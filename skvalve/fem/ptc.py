@@ -109,13 +109,16 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
                      *, u0: np.ndarray | None = None, t0: float = 0.0, edges: np.ndarray | None = None,
                      rest_lengths: np.ndarray | None = None,
                      callbacks: Sequence[Callable[[PseudoTransientStep], None]] = (), progress: bool = True,
-                     verbose: bool = False) -> PseudoTransientResult:
+                     verbose: bool = False,
+                     limit: Callable[[np.ndarray, np.ndarray], float] | None = None) -> PseudoTransientResult:
     """Follow the load factor from ``t0`` to ``end`` and relax to the equilibrium at ``end`` (module docstring).
 
     ``weights``: the diagonal :math:`M` (n_dofs,), e.g. :func:`~skvalve.fem.damping.lumped_volume`; dofs with zero
     weight get no damping. ``edges``: (m, 2) node pairs (element edges, cables) watched by ``max_strain_increment``,
     ``rest_lengths`` the lengths from which each carries tension (default: the reference lengths; for a cable, its
-    rest length).
+    rest length). ``limit``: ``limit(u, du) -> f`` in (0, 1], the fraction of a pseudo-step's increment that may be
+    taken (e.g. :func:`~skvalve.fem.contact_clearance.clearance_fraction`); a step with ``f < 1`` is rejected and
+    ``dtau`` cut to ``max(0.1, 0.8 f)`` of itself (a pseudo-step's increment shrinks about as ``dtau``).
     Returns a :class:`PseudoTransientResult` with ``converged`` set; raises
     :class:`~skvalve.fem.errors.ConvergenceError` / :class:`~skvalve.fem.errors.NonPositiveJacobianError` when the
     step falls below ``min_step`` or ``max_steps`` pass (``error.last_state``: the last accepted result).
@@ -180,7 +183,7 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
                 local = np.where(boost > 1.0, floor, weights)
                 trial, trial_residual, trial_tangent, largest = _step(problem, u, t, t_new, dtau, tangent, local,
                                                                        boost, norm, opts, solver, step,
-                                                                       result.timings, edges, float(beta))
+                                                                       result.timings, edges, float(beta), limit)
             except _Rejected as err:
                 problem.rewind()
                 result.rejected += 1
@@ -237,7 +240,8 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
 
 
 def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent, weights, boost, norm: float,
-          opts: PseudoTransientOptions, solver: str, step: int, timings: dict, edges: tuple | None, beta: float):
+          opts: PseudoTransientOptions, solver: str, step: int, timings: dict, edges: tuple | None, beta: float,
+          limit=None):
     """One linearised implicit-Euler step with the damping diagonal ``boost * (c weights + beta |diag K|)``;
     raises :class:`_Rejected` (with a cut ``factor`` and the ``nodes`` to damp) when it fails a test."""
     pattern = problem.pattern
@@ -278,6 +282,12 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
     if opts.max_increment is not None and largest > opts.max_increment:
         raise _Rejected(f"a node would move {largest:.3g} > max_increment {opts.max_increment:g}",
                         max(0.1, 0.7 * opts.max_increment / largest), np.flatnonzero(moves > opts.max_increment))
+    if limit is not None:
+        fraction = float(limit(u, trial + du - u))  # with the prescribed increments
+        if not (0.0 < fraction <= 1.0):
+            raise ValueError(f"pseudo-transient: the step limit must return a fraction in (0, 1]; got {fraction!r}")
+        if fraction < 1.0:
+            raise _Rejected(f"the step limit allows {fraction:.3g} of the increment", max(0.1, 0.8 * fraction))
     trial[free] += du_free
     if edges is not None and opts.max_strain_increment is not None and edges[0].size:
         changes = _stretch_changes(edges[2], u, trial, edges[0], edges[1])

@@ -130,15 +130,19 @@ class ClosureOptions:
     def for_relaxation(cls, model: ValveModel, **overrides) -> ClosureOptions:
         """:meth:`for_model` set up for :func:`relax_closure`: no damping term (the solver damps), the chordae at
         their full law from the start (no soft start: the pseudo-transient steps follow the tips without it), the
-        contact penalty switched on by a smooth step over 0.1 of step time, no contact between skins that are
+        contact penalty switched on from the start by a smooth step over 0.1 of step time (a linearised step does not
+        chatter between active sets as Newton did, and the clearance limit, which holds every node to half the search
+        depth, needs the penalty to push back: from the pressure's start instead, the papillary stage of the 1.0
+        diseased valve drove a rim node 0.25 mm into another leaflet by step time 0.43, where the limit stopped Ψtc), no
+        contact between skins that are
         less than 1 mm apart in the reference (more than the 0.78 mm leaflet thickness), the single input trusses
         carrying their law in compression as the input's do (``cable_compression``: the fans of single trusses at the
         chordae branch points are then struts, not mechanisms held by slack springs), and blended contact
         (``contact_blend`` 0.1: on the 1.0 diseased valve the closest-triangle rule left 64 % of the held residual's
         square on one crease of the septal leaflet, 50 % of it on two nodes; blended from the pressure's start, 0.4 %
         on contact nodes, half of it spread over 2873 nodes)."""
-        fitted = {"damping": 0.0, "cable_softening": 1.0, "contact_ramp": 0.1, "contact_exclude_within": 1.0,
-                  "cable_compression": True, "contact_blend": 0.1}
+        fitted = {"damping": 0.0, "cable_softening": 1.0, "contact_from": 0.0, "contact_ramp": 0.1,
+                  "contact_exclude_within": 1.0, "cable_compression": True, "contact_blend": 0.1}
         fitted.update(overrides)
         return cls.for_model(model, **fitted)
 
@@ -346,9 +350,10 @@ def relax_closure(setup: ClosureSetup, end: float,
     other (:func:`relaxation_options`). ``held``: relax at the held load with the energy trust region
     (:func:`~skvalve.fem.trust_region.trust_region`, with the chordae branch points relaxed after each step:
     :func:`hub_relaxation`) instead, from the first state Ψtc reaches there (its last stage then stops as soon as the
-    load is held, once its relative residual is below 1). Never raises for a failed
-    run: the error and the kept state are recorded (the last accepted one; after Ψtc gave up at the held load, the
-    held state with the smallest residual).
+    load is held, once its relative residual is below 1). Ψtc's and the trust region's steps are both limited by the
+    contact clearance (:func:`~skvalve.fem.contact_clearance.clearance_fraction`). Never raises for a failed run:
+    the error and the kept state are recorded (the last accepted one; after Ψtc gave up at the held load, the held
+    state with the smallest residual).
     """
     if setup.damping is not None:
         raise ValueError("relax_closure damps through the solver: build the setup with ClosureOptions(damping=0)")
@@ -364,6 +369,7 @@ def relax_closure(setup: ClosureSetup, end: float,
 
     edges, rest_lengths = watched_edges(setup.model) if setup.model is not None else (None, None)
     weights = damping_weights(setup.problem.space)
+    clearance = partial(clearance_fraction, setup.contact)
     start = time.perf_counter()
     result = None
 
@@ -383,7 +389,7 @@ def relax_closure(setup: ClosureSetup, end: float,
                 stage = replace(stage, rtol=1.0)
             result = pseudo_transient(setup.problem, weights, stop, stage, u0=u0, t0=t0, edges=edges,
                                       rest_lengths=rest_lengths, callbacks=[record, *callbacks], progress=progress,
-                                      verbose=verbose)
+                                      verbose=verbose, limit=clearance)
             add_effort(result)
             u0, t0 = result.u, result.load_factor
             if stop >= end:
@@ -392,7 +398,7 @@ def relax_closure(setup: ClosureSetup, end: float,
             hubs = hub_relaxation(setup) if setup.model is not None else None
             result = trust_region(setup.problem, end, u0, held, edges=edges, rest_lengths=rest_lengths,
                                   callbacks=[record, *callbacks], progress=progress, verbose=verbose, relax=hubs,
-                                  limit=partial(clearance_fraction, setup.contact))
+                                  limit=clearance)
             add_effort(result)
             run.negative_eigenvalues = result.negative_eigenvalues
     except Exception as err:  # noqa: BLE001 - a failed closure is a result to report, with its last state
