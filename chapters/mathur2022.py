@@ -619,7 +619,7 @@ if HAVE_DATA:
 #   share of what its quadratic model predicts. The follower pressure on leaflets with free edges is not
 #   conservative, so close to equilibrium that energy is only approximate; below a relative residual of 1e-4 each step
 #   first tries Newton's step with the full tangent and keeps it when the residual halves. Every step, damped or not,
-#   is cut where it would carry a contact node deeper than half the search depth through a leaflet
+#   is cut where it would carry a contact node deeper than ¾ of the search depth through a leaflet
 #   (`skvalve.fem.contact_clearance`: the gap of each near node-triangle pair followed along the step; sliding is
 #   free): past that depth the penalty fades out and would let the node through. It prints all Table 2–3
 #   rows of the diseased column, with a VTU/PVD

@@ -50,15 +50,16 @@ def test_a_rigid_motion_is_free_and_an_approach_is_held_to_half_the_depth():
     assert clearance_fraction(contact, u, np.tile([3.0, -2.0, 5.0], X.shape[1])) == 1.0  # no relative motion
     step = np.zeros_like(u)
     step[2::3][X[2] > 1.0 + 0.5 * GAP] = -1.0  # the top block 1.0 down: through the bottom one
-    # the faces are parallel, so the gap is GAP - f: it reaches -DEPTH/2 at f = GAP + DEPTH/2
-    assert clearance_fraction(contact, u, step) == pytest.approx(GAP + 0.5 * DEPTH, abs=1e-8)
+    # the faces are parallel, so the gap is GAP - f: it reaches -3 DEPTH/4 at f = GAP + 3 DEPTH/4
+    assert clearance_fraction(contact, u, step) == pytest.approx(GAP + 0.75 * DEPTH, abs=1e-8)
     assert clearance_fraction(contact, u, 0.2 * step) == 1.0  # ends 0.0 apart
 
 
-def test_a_close_node_slides_freely_and_goes_no_deeper():
-    """The top block already 0.04 through the bottom one (under half the depth) may slide 1.0 sideways in one step
-    (a bound on the relative motion alone would allow 0.05); a node pushed 0.7 of the depth through may come out but
-    not go deeper."""
+def test_a_close_node_slides_freely_and_goes_no_deeper_than_three_quarters_of_the_depth():
+    """The top block already 0.04 through the bottom one may slide 1.0 sideways in one step (a bound on the relative
+    motion alone would allow 0.05) and go 3/4 of the depth - 0.04 deeper; one coming in from the side, past the
+    other's free edges, may come in at 0.6 of the depth but not sink to 0.9 as it does; a node already 0.78 of the
+    depth through (in the fade-out) is left free."""
     problem, contact = _blocks()
     X = problem.space.dof_coordinates
     top = X[2] > 1.0 + 0.5 * GAP
@@ -69,10 +70,15 @@ def test_a_close_node_slides_freely_and_goes_no_deeper():
     assert clearance_fraction(contact, u, slide) == 1.0
     down = np.zeros_like(u)
     down[2::3][top] = -1.0
-    assert clearance_fraction(contact, u, down) == pytest.approx(0.5 * DEPTH - 0.04, abs=1e-8)
-    u[2::3][top] = -(GAP + 0.7 * DEPTH)
-    assert clearance_fraction(contact, u, -down) == 1.0  # out: free
-    assert clearance_fraction(contact, u, 0.01 * down) < 1e-6  # deeper: not at all
+    assert clearance_fraction(contact, u, down) == pytest.approx(0.75 * DEPTH - 0.04, abs=1e-8)
+    u[0::3][top], u[2::3][top] = 1.5, -(GAP + 0.6 * DEPTH)  # beside the bottom block, out of its triangles' bands
+    back = np.zeros_like(u)
+    back[0::3][top] = -1.5
+    assert clearance_fraction(contact, u, back) == 1.0
+    assert clearance_fraction(contact, u, back + 0.3 * DEPTH * down) < 1.0
+    u[0::3][top], u[2::3][top] = 0.0, -(GAP + 0.78 * DEPTH)
+    assert clearance_fraction(contact, u, -down) == 1.0  # out
+    assert clearance_fraction(contact, u, 0.01 * down) == 1.0  # in the fade-out: the energy lets it go
 
 
 def test_the_limit_keeps_a_long_step_from_carrying_a_block_through_another():
