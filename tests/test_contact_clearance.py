@@ -10,6 +10,7 @@ import skfem
 
 from skvalve.fem import HyperelasticTerm, MaterialRegions, Problem, Space
 from skvalve.fem.contact import ContactSurface, SurfaceContact
+from skvalve.fem.contact_blend import free_edges
 from skvalve.fem.contact_clearance import clearance_fraction
 from skvalve.fem.damping import lumped_volume
 from skvalve.fem.ptc import PseudoTransientOptions, pseudo_transient
@@ -130,6 +131,21 @@ def test_the_limit_keeps_a_pseudo_transient_step_from_carrying_a_block_through_a
     problem, _ = _blocks()
     with pytest.raises(ValueError, match="fraction in"):
         pseudo_transient(problem, lumped_volume(problem.space), 1.0, options, progress=False, limit=lambda u, p: 2.0)
+
+
+def test_the_limit_counts_the_pairs_the_energy_counts():
+    """The facing factor and band the limit uses are the contact energy's own: for the pairs of a blended search they
+    reproduce the factors it lists, and the band is -2 beta past a free edge, -beta past a shared one."""
+    problem, contact = _blocks()
+    X = problem.space.dof_coordinates
+    u = np.zeros(problem.space.n_dofs)
+    u[2::3][X[2] > 1.0 + 0.5 * GAP] = -(GAP + 0.02)
+    pairs = contact.active_pairs(u)
+    assert pairs.size > 0
+    x = contact.X + u[: problem.space.n_u].reshape(-1, 3)
+    np.testing.assert_allclose(contact.facing(pairs.node, pairs.triangle, x), pairs.facing, rtol=0, atol=1e-14)
+    lower = contact.band_lower(np.arange(contact.surface.triangles.shape[0]))
+    assert set(np.unique(lower)) == {-0.2, -0.1} and np.all((lower == -0.2) == free_edges(contact.surface.triangles))
 
 
 def test_a_limit_outside_zero_to_one_is_refused():

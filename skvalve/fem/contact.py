@@ -302,16 +302,32 @@ class SurfaceContact(Term):
         ok = (gap < self.above) & (gap > -self.max_penetration)
         node, triangle, gap, corners = node[ok], triangle[ok], gap[ok], corners[ok]
         weights = barycentric(x[node], corners)
-        lower = np.where(self._free_edges[triangle], -2.0 * self.blend, -self.blend)
-        ok = np.all(weights > lower, axis=1)
+        ok = np.all(weights > self.band_lower(triangle), axis=1)
         node, triangle, gap, weights = node[ok], triangle[ok], gap[ok], weights[ok]
-        x0 = x if self._committed_u is None else self.X + self._committed_u[: self.space.n_u].reshape(-1, 3)
-        c0 = x0[self.surface.triangles[triangle]]
-        m0 = np.cross(c0[:, 1] - c0[:, 0], c0[:, 2] - c0[:, 0])
-        cosine = np.einsum("ij,ij->i", self.node_normals(x0)[node], m0 / np.linalg.norm(m0, axis=1, keepdims=True))
-        facing = smooth_step((-cosine - self.opposing) / FACING_BAND)[0]
+        facing = self.facing(node, triangle, x)
         ok = facing > 0.0
         return ActivePairs(node[ok], triangle[ok], gap[ok], weights[ok], facing[ok])
+
+    def band_lower(self, triangle: np.ndarray) -> np.ndarray:
+        """(n, 3) the smallest barycentric coordinates at which a node's projection still pairs with each triangle:
+        ``-tolerance`` (closest-triangle rule); blended, ``-2 blend`` opposite a free edge and ``-blend`` opposite a
+        shared one."""
+        if self.blend == 0.0:
+            return np.full((np.size(triangle), 3), -self.tolerance)
+        return np.where(self._free_edges[triangle], -2.0 * self.blend, -self.blend)
+
+    def facing(self, node: np.ndarray, triangle: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """(n,) how far each node and triangle face each other: blended contact, the smooth factor
+        :math:`S((-n_s\\cdot n - c)/0.2)` at the last committed state (``x``, the current positions, before any
+        commit); closest-triangle rule, 1 where :math:`n_s\\cdot n < -c` at ``x``, else 0."""
+        if self.blend > 0.0 and self._committed_u is not None:
+            x = self.X + self._committed_u[: self.space.n_u].reshape(-1, 3)
+        c = x[self.surface.triangles[triangle]]
+        m = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
+        cosine = np.einsum("ij,ij->i", self.node_normals(x)[node], m / np.linalg.norm(m, axis=1, keepdims=True))
+        if self.blend == 0.0:
+            return (cosine < -self.opposing).astype(float)
+        return smooth_step((-cosine - self.opposing) / FACING_BAND)[0]
 
     def commit(self) -> None:
         """Blended contact: the last assembled state becomes the one whose normals set the facing factors."""

@@ -7,9 +7,12 @@ through (the 1.0 valve's search depth, 0.50 mm, is more than its two-layer leafl
 every node's motion at :math:`g_\max` prevents that, but it also holds back the parts of a structure that swing or
 slide together. This limit looks at what matters, pair by pair: for a node :math:`i` of the surface and a triangle
 :math:`T` it may contact (not a topological neighbour, not excluded by reference distance: the pairs the contact
-search itself keeps), with normals opposed and the node no deeper than :math:`\tfrac34 g_\max` below the triangle's
-plane, the gap :math:`g(f)` (:mod:`~skvalve.fem.contact_geometry`) is followed along the step :math:`f p`, and
-wherever the node's projection lies in the triangle's band (barycentric coordinates :math:`\ge -2\beta`) it must stay
+search itself keeps) that the energy counts as facing (:meth:`~skvalve.fem.contact.SurfaceContact.facing`) and
+with the node no deeper than :math:`\tfrac34 g_\max` below the triangle's plane, the gap :math:`g(f)`
+(:mod:`~skvalve.fem.contact_geometry`) is followed along the step :math:`f p`, and wherever the node's projection lies
+where the pair's band weight is at least ½ (:meth:`~skvalve.fem.contact.SurfaceContact.band_lower` plus
+:math:`\beta`: barycentric coordinates :math:`\ge -\beta` opposite a free edge, :math:`\ge 0` opposite a shared one,
+past which the node lies over the neighbour, whose pair guards it) it must stay
 
 .. math::
 
@@ -21,7 +24,9 @@ shallower, and the step's energy test sees every barrier. Pairs already deeper a
 fade-out, whose energy lets them go. (A first version allowed half the depth, and held nodes already deeper to the
 depth they had: a node held at the edge of a triangle's band 0.32 mm below it, next to a free edge, stopped Ψtc on the
 1.0 valve, and one 0.9 of the depth below a triangle of the 1.1 valve stopped the trust region; within the band the
-full penalty pushes a node out long before three quarters of the depth.)
+full penalty pushes a node out long before three quarters of the depth. Pairs whose normals were opposed, but too
+little for the energy to count them, held a 1.1 node at three quarters of the depth, with nothing pushing it out; so
+did a pair at the edge of its band past a shared edge, 0.75 of the depth below the plane of a triangle on a crease.)
 
 :math:`g(f)` is sampled at :math:`\max(8, 4 m/g_\max)` points (at most 64; :math:`m` the largest motion of a node
 relative to a triangle's corner), so that between samples a gap changes by about a quarter of the depth, and the first
@@ -87,21 +92,23 @@ def clearance_fraction(contact: SurfaceContact, u: np.ndarray, p: np.ndarray) ->
     corner_ids = triangles[triangle]
     relative = np.linalg.norm(motion[node][:, None, :] - motion[corner_ids], axis=2).max(axis=1)
     reaching = relative > distance  # no other pair can end in its triangle's band within the depth
-    node, corner_ids, relative = node[reaching], corner_ids[reaching], relative[reaching]
+    node, triangle, corner_ids, relative = node[reaching], triangle[reaching], corner_ids[reaching], relative[reaching]
     if node.size == 0:
         return 1.0
     gap0, _ = _gap_and_band(x, motion, node, corner_ids, 0.0)
-    c = x[corner_ids]
-    opposed = np.einsum("ij,ij->i", contact.node_normals(x)[node], np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])) < 0
     floor = -ALLOWED_DEPTH * depth
-    seen = opposed & (gap0 >= floor)  # deeper pairs are in the fade-out already: the energy lets them go
+    # the pairs the energy sees (facing), not yet in the fade-out (deeper ones: the energy lets them go)
+    seen = (gap0 >= floor) & (contact.facing(node, triangle, x) > 0.0)
+    # where the pair's band weight is at least 1/2: over the triangle itself (shared edges: a node past one lies over
+    # the neighbour, whose pair guards it) and up to beta past a free edge
+    lower = contact.band_lower(triangle[seen]) + contact.blend
     node, corner_ids = node[seen], corner_ids[seen]
     if node.size == 0:
         return 1.0
 
     def violated(f: np.ndarray, which: np.ndarray) -> np.ndarray:
         gap, lam = _gap_and_band(x, motion, node[which], corner_ids[which], f)
-        return (gap < floor) & (lam.min(axis=1) >= band)
+        return (gap < floor) & np.all(lam >= lower[which], axis=1)
 
     samples = int(min(MAX_SAMPLES, max(MIN_SAMPLES, math.ceil(4.0 * float(relative.max()) / depth))))
     crossing = np.full(node.size, np.inf)
