@@ -255,8 +255,6 @@ def test_options_fitted_to_the_staging_of_an_input():
     assert (staged.end, staged.pressure_start, staged.damping_off) == (1.5, 0.5, 1.25)
     assert staged.cable_stiffening == (0.4, 0.6) and staged.cable_softening == ClosureOptions.cable_softening
     assert staged.contact_from == 0.5 and ClosureOptions.for_model(stub(0.0, 1.0)).contact_from == 0.0
-    # Ψtc: contact from the start (the clearance limit needs the penalty to push back in the papillary stage)
-    assert ClosureOptions.for_relaxation(stub(0.5, 1.5)).contact_from == 0.0
     together = ClosureOptions.for_model(stub(0.0, 1.0), pressure_steps=4)
     fitted = (together.end, together.pressure_start, together.damping_off, together.cable_softening)
     assert fitted == (1.0, 0.0, 0.75, 1.0)

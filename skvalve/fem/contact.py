@@ -229,6 +229,7 @@ class SurfaceContact(Term):
         self._previous = np.full(space.n_scalar, -1, dtype=np.int64)  # triangle of each node at the last search
         self.last_force = np.zeros(space.n_u)
         self.last_energy = 0.0
+        self.last_load_factor: float | None = None  # of the last assembly (the penalty's argument)
         self._assembled_u: np.ndarray | None = None
         self._committed_u: np.ndarray | None = None  # blended contact: the state whose normals give the facing
 
@@ -379,6 +380,7 @@ class SurfaceContact(Term):
 
     # ---------------------------------------------------------------- assembly
     def assemble(self, u: np.ndarray, t: float, tangent: bool, step: int | None) -> Contribution:
+        self.last_load_factor = float(t)
         if self.blend > 0.0:  # the state whose normals give the facing factors once committed
             self._assembled_u = np.array(u, dtype=float)
         pairs = self.active_pairs(u)

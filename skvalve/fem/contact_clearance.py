@@ -19,14 +19,19 @@ past which the node lies over the neighbour, whose pair guards it) it must stay
     g(f) \ge -\tfrac34 g_\max :
 
 a node may slide along a sheet, come out of it or come in from the side freely, but no step takes it deeper than
-three quarters of the depth, short of the fade-out. So a node never reaches the fade-out from a state where it was
-shallower, and the step's energy test sees every barrier. Pairs already deeper are left free: they are in the
-fade-out, whose energy lets them go. (A first version allowed half the depth, and held nodes already deeper to the
-depth they had: a node held at the edge of a triangle's band 0.32 mm below it, next to a free edge, stopped Ψtc on the
-1.0 valve, and one 0.9 of the depth below a triangle of the 1.1 valve stopped the trust region; within the band the
-full penalty pushes a node out long before three quarters of the depth. Pairs whose normals were opposed, but too
-little for the energy to count them, held a 1.1 node at three quarters of the depth, with nothing pushing it out; so
-did a pair at the edge of its band past a shared edge, 0.75 of the depth below the plane of a triangle on a crease.)
+three quarters of the depth, short of the fade-out. So no step carries a node from a shallower state into the
+fade-out, and the step's energy test sees the barrier. Pairs already at 0.74 of the depth or deeper are let go: a node
+that the forces hold at its floor despite the full penalty would otherwise stop every step (this happened on the 1.1
+valve), and from there on only the energy test stands in its way.
+
+Earlier rules each stopped a valve run at one node held at its floor: half the depth, with nodes already deeper held
+to their depth (a node at the edge of a band next to a free edge, 0.32 mm below it, stopped Ψtc on the 1.0 valve; one
+0.9 of the depth below a 1.1 triangle, the trust region); normals merely opposed instead of facing as the energy counts
+them; the whole band past a shared edge (0.75 of the depth below a triangle on a crease, over its neighbour).
+
+While the penalty is zero (at the load factor of the contact's last assembly, which is the step's: both solvers
+assemble at the step's load before they limit it) the limit lets every step through: there is no barrier to cross
+unseen, and a node held at its floor would have nothing to push it back.
 
 :math:`g(f)` is sampled at :math:`\max(8, 4 m/g_\max)` points (at most 64; :math:`m` the largest motion of a node
 relative to a triangle's corner), so that between samples a gap changes by about a quarter of the depth, and the first
@@ -57,6 +62,9 @@ MIN_SAMPLES = 8
 MAX_SAMPLES = 64
 #: How deep (a fraction of the search depth) a step may take a node through a triangle: short of the fade-out.
 ALLOWED_DEPTH = DEEP_FADE - 0.05  # 0.75
+#: A pair whose node is this deep already is let go (just short of the allowed depth: a node the forces hold at its
+#: floor would otherwise stop every step).
+RELEASED_DEPTH = ALLOWED_DEPTH - 0.01
 #: The smallest fraction returned (a node held at its floor allows no step along this direction).
 MIN_FRACTION = 1e-12
 #: Bisection steps on the first sampled crossing.
@@ -69,6 +77,9 @@ def clearance_fraction(contact: SurfaceContact, u: np.ndarray, p: np.ndarray) ->
     """The largest fraction :math:`f \\le 1` of the step ``p`` from ``u`` (full dof vectors) that carries no node of
     ``contact``'s surface from above to deeper than three quarters of its search depth through a triangle it may
     contact (module docstring)."""
+    t = contact.last_load_factor
+    if t is not None and not contact.penalty(t) > 0.0:  # no penalty acting (yet): no barrier a step could cross
+        return 1.0
     n_u = contact.space.n_u
     nodes, triangles = contact.surface.nodes, contact.surface.triangles
     x = contact.X + u[:n_u].reshape(-1, 3)
@@ -97,8 +108,8 @@ def clearance_fraction(contact: SurfaceContact, u: np.ndarray, p: np.ndarray) ->
         return 1.0
     gap0, _ = _gap_and_band(x, motion, node, corner_ids, 0.0)
     floor = -ALLOWED_DEPTH * depth
-    # the pairs the energy sees (facing), not yet in the fade-out (deeper ones: the energy lets them go)
-    seen = (gap0 >= floor) & (contact.facing(node, triangle, x) > 0.0)
+    # the pairs the energy sees (facing), short of the floor (a node held at its floor is let go: nothing else moves)
+    seen = (gap0 > -RELEASED_DEPTH * depth) & (contact.facing(node, triangle, x) > 0.0)
     # where the pair's band weight is at least 1/2: over the triangle itself (shared edges: a node past one lies over
     # the neighbour, whose pair guards it) and up to beta past a free edge
     lower = contact.band_lower(triangle[seen]) + contact.blend

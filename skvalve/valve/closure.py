@@ -130,19 +130,17 @@ class ClosureOptions:
     def for_relaxation(cls, model: ValveModel, **overrides) -> ClosureOptions:
         """:meth:`for_model` set up for :func:`relax_closure`: no damping term (the solver damps), the chordae at
         their full law from the start (no soft start: the pseudo-transient steps follow the tips without it), the
-        contact penalty switched on from the start by a smooth step over 0.1 of step time (a linearised step does not
-        chatter between active sets as Newton did, and the clearance limit, which holds every node to half the search
-        depth, needs the penalty to push back: from the pressure's start instead, the papillary stage of the 1.0
-        diseased valve drove a rim node 0.25 mm into another leaflet by step time 0.43, where the limit stopped Ψtc), no
-        contact between skins that are
-        less than 1 mm apart in the reference (more than the 0.78 mm leaflet thickness), the single input trusses
+        contact penalty switched on by a smooth step over 0.1 of step time from the pressure's start (from the start
+        instead, one rim node of the 1.0 diseased valve, paired with its own leaflet 3.3 mm away, throttled the
+        papillary stage to pseudo-steps of 1e-5 by its edges' stretch limit), no contact between skins that are less
+        than 1 mm apart in the reference (more than the 0.78 mm leaflet thickness), the single input trusses
         carrying their law in compression as the input's do (``cable_compression``: the fans of single trusses at the
         chordae branch points are then struts, not mechanisms held by slack springs), and blended contact
         (``contact_blend`` 0.1: on the 1.0 diseased valve the closest-triangle rule left 64 % of the held residual's
         square on one crease of the septal leaflet, 50 % of it on two nodes; blended from the pressure's start, 0.4 %
         on contact nodes, half of it spread over 2873 nodes)."""
-        fitted = {"damping": 0.0, "cable_softening": 1.0, "contact_from": 0.0, "contact_ramp": 0.1,
-                  "contact_exclude_within": 1.0, "cable_compression": True, "contact_blend": 0.1}
+        fitted = {"damping": 0.0, "cable_softening": 1.0, "contact_ramp": 0.1, "contact_exclude_within": 1.0,
+                  "cable_compression": True, "contact_blend": 0.1}
         fitted.update(overrides)
         return cls.for_model(model, **fitted)
 
