@@ -65,8 +65,8 @@ ALLOWED_DEPTH = DEEP_FADE - 0.05  # 0.75
 #: A pair whose node is this deep already is let go (just short of the allowed depth: a node the forces hold at its
 #: floor would otherwise stop every step).
 RELEASED_DEPTH = ALLOWED_DEPTH - 0.01
-#: The smallest fraction returned (a node held at its floor allows no step along this direction).
-MIN_FRACTION = 1e-12
+#: A pair that allows less than this fraction of a step is let go (held at its floor, it would stop every step).
+MIN_FRACTION = 1e-9
 #: Bisection steps on the first sampled crossing.
 BISECTIONS = 30
 #: A pair is followed if its node can come within the band's reach plus this many search depths of the centroid.
@@ -138,7 +138,8 @@ def clearance_fraction(contact: SurfaceContact, u: np.ndarray, p: np.ndarray) ->
         hit = violated(middle, which)
         high = np.where(hit, middle, high)
         low = np.where(hit, low, middle)
-    return max(float(low.min()), MIN_FRACTION)
+    held = low < MIN_FRACTION  # crossing at once: held at its floor (or at a crease of the gap); let go, as above
+    return 1.0 if np.all(held) else float(low[~held].min())
 
 
 def _gap_and_band(x, motion, node, corner_ids, f):
