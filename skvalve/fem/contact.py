@@ -71,7 +71,7 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from .contact_blend import free_edges, pair_weights, sheets, weighted_mean_energy
-from .contact_geometry import barycentric, barycentric_derivatives, gap_derivatives, smooth_step
+from .contact_geometry import barycentric, barycentric_derivatives, gap_derivatives, plane_gap, smooth_step
 from .space import Space
 from .terms import Contribution, Term
 
@@ -262,9 +262,7 @@ class SurfaceContact(Term):
         keep = self.may_contact(node, triangle)
         node, triangle = node[keep], triangle[keep]
         c = corners[triangle]
-        m = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
-        normal = m / np.linalg.norm(m, axis=1, keepdims=True)
-        gap = np.einsum("ij,ij->i", x[node] - c[:, 0], normal)
+        gap, normal = plane_gap(x[node], c)
         if self.blend > 0.0:
             return self._blended_candidates(x, node, triangle, gap, c)
         ok = (gap < 0.0) & (gap > -self.max_penetration)

@@ -52,7 +52,7 @@ from scipy.spatial import cKDTree
 
 from .contact import SurfaceContact
 from .contact_blend import DEEP_FADE
-from .contact_geometry import barycentric
+from .contact_geometry import barycentric, plane_gap
 
 __all__ = ["clearance_fraction"]
 
@@ -97,7 +97,9 @@ def clearance_fraction(contact: SurfaceContact, u: np.ndarray, p: np.ndarray) ->
                                                     output_type="ndarray")
     node, triangle = nodes[near["i"]], near["j"].astype(np.int64)
     distance = near["v"] - reach[triangle]
-    keep = distance < 2.0 * largest
+    # |p_i| + max_v |p_v| bounds the relative motion: a cheap first cut before the exclusions and the exact bound
+    speed = np.linalg.norm(motion, axis=1)
+    keep = speed[node] + speed[triangles].max(axis=1)[triangle] > distance
     keep[keep] = contact.may_contact(node[keep], triangle[keep])
     node, triangle, distance = node[keep], triangle[keep], distance[keep]
     corner_ids = triangles[triangle]
@@ -106,7 +108,7 @@ def clearance_fraction(contact: SurfaceContact, u: np.ndarray, p: np.ndarray) ->
     node, triangle, corner_ids, relative = node[reaching], triangle[reaching], corner_ids[reaching], relative[reaching]
     if node.size == 0:
         return 1.0
-    gap0, _ = _gap_and_band(x, motion, node, corner_ids, 0.0)
+    gap0, _ = plane_gap(x[node], x[corner_ids])
     floor = -ALLOWED_DEPTH * depth
     # the pairs the energy sees (facing), short of the floor (a node held at its floor is let go: nothing else moves)
     seen = (gap0 > -RELEASED_DEPTH * depth) & (contact.facing(node, triangle, x) > 0.0)
@@ -118,8 +120,13 @@ def clearance_fraction(contact: SurfaceContact, u: np.ndarray, p: np.ndarray) ->
         return 1.0
 
     def violated(f: np.ndarray, which: np.ndarray) -> np.ndarray:
-        gap, lam = _gap_and_band(x, motion, node[which], corner_ids[which], f)
-        return (gap < floor) & np.all(lam >= lower[which], axis=1)
+        """Pairs ``which`` past the floor at ``x + f motion`` (``f`` one per pair), with the projection in the band."""
+        f = f[:, None]
+        xs = x[node[which]] + f * motion[node[which]]
+        c = x[corner_ids[which]] + f[:, :, None] * motion[corner_ids[which]]
+        hit = plane_gap(xs, c)[0] < floor
+        hit[hit] = np.all(barycentric(xs[hit], c[hit]) >= lower[which[hit]], axis=1)  # the band only where deep
+        return hit
 
     samples = int(min(MAX_SAMPLES, max(MIN_SAMPLES, math.ceil(4.0 * float(relative.max()) / depth))))
     crossing = np.full(node.size, np.inf)
@@ -141,12 +148,3 @@ def clearance_fraction(contact: SurfaceContact, u: np.ndarray, p: np.ndarray) ->
     held = low < MIN_FRACTION  # crossing at once: held at its floor (or at a crease of the gap); let go, as above
     return 1.0 if np.all(held) else float(low[~held].min())
 
-
-def _gap_and_band(x, motion, node, corner_ids, f):
-    """Gap (n,) and barycentric coordinates (n, 3) of each node over its triangle at ``x + f motion``."""
-    f = np.asarray(f, dtype=float).reshape(-1, 1)
-    xs = x[node] + f * motion[node]
-    c = x[corner_ids] + f[:, :, None] * motion[corner_ids]
-    m = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
-    normal = m / np.linalg.norm(m, axis=1, keepdims=True)
-    return np.einsum("ij,ij->i", xs - c[:, 0], normal), barycentric(xs, c)

@@ -283,9 +283,7 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
         raise _Rejected(f"a node would move {largest:.3g} > max_increment {opts.max_increment:g}",
                         max(0.1, 0.7 * opts.max_increment / largest), np.flatnonzero(moves > opts.max_increment))
     if limit is not None:
-        fraction = float(limit(u, trial + du - u))  # with the prescribed increments
-        if not (0.0 < fraction <= 1.0):
-            raise ValueError(f"pseudo-transient: the step limit must return a fraction in (0, 1]; got {fraction!r}")
+        fraction = _limited(limit, u, trial + du - u, "pseudo-transient")  # with the prescribed increments
         if fraction < 1.0:
             raise _Rejected(f"the step limit allows {fraction:.3g} of the increment", max(0.1, 0.8 * fraction))
     trial[free] += du_free
@@ -313,6 +311,14 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
         carriers = _carriers(trial_residual, free, space)
         raise _Rejected(f"|R| grows from {reference:.3e} to {trial_norm:.3e}", nodes=carriers)
     return trial, trial_residual, trial_tangent, largest
+
+
+def _limited(limit, u: np.ndarray, p: np.ndarray, solver: str) -> float:
+    """``limit(u, p)``, checked to be a fraction in (0, 1] (``solver`` names the caller in the error)."""
+    fraction = float(limit(u, p))
+    if not 0.0 < fraction <= 1.0:
+        raise ValueError(f"{solver}: the step limit must return a fraction in (0, 1]; got {fraction!r}")
+    return fraction
 
 
 def _carriers(residual: np.ndarray, free: np.ndarray, space, share: float = 0.9, most: int = 1000) -> np.ndarray:

@@ -58,7 +58,7 @@ from . import linsolve
 from .errors import ConvergenceError, NonPositiveJacobianError
 from .newton import reference_force
 from .problem import Problem, Tangent
-from .ptc import _checked_edges, _stretch_changes
+from .ptc import _checked_edges, _limited, _stretch_changes
 
 __all__ = ["TrustRegionOptions", "TrustRegionStep", "TrustRegionResult", "trust_region", "step_matrix",
            "project_psd", "project_sparse_psd", "work_along"]
@@ -392,7 +392,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                     factor *= opts.max_strain_increment / change
                     held_by = "stretch"
             if limit is not None:
-                fraction = _limited(limit, u, factor * p)
+                fraction = _limited(limit, u, factor * p, "trust region")
                 if fraction < 1.0:
                     factor *= fraction
                     held_by = "limit"
@@ -465,13 +465,6 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
     return result
 
 
-def _limited(limit, u: np.ndarray, p: np.ndarray) -> float:
-    fraction = float(limit(u, p))
-    if not 0.0 < fraction <= 1.0:
-        raise ValueError(f"trust region: the step limit must return a fraction in (0, 1]; got {fraction!r}")
-    return fraction
-
-
 def _newton_try(problem, solver, K, residual, u, t, step, radius, norm, opts, result, limit):
     """Newton's step with the full tangent, scaled into ``radius``: (step, residual, tangent, trapezoidal work,
     largest nodal motion) when the residual norm falls below ``newton_decrease * norm``, else None (rewound)."""
@@ -493,7 +486,7 @@ def _newton_try(problem, solver, K, residual, u, t, step, radius, norm, opts, re
         p *= radius / largest
         largest = radius
     if limit is not None:
-        fraction = _limited(limit, u, p)
+        fraction = _limited(limit, u, p, "trust region")
         p *= fraction
         largest *= fraction
     clock = time.perf_counter()
