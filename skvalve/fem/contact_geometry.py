@@ -33,8 +33,8 @@ __all__ = ["barycentric", "barycentric_derivatives", "gap_derivatives", "plane_g
 
 
 def plane_gap(xs: np.ndarray, corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Gap ``g = (x_s - x_1) . n`` (n,) of points ``xs`` (n, 3) over the planes of triangles ``corners`` (n, 3, 3),
-    and the unit normals ``n`` (n, 3) (no derivatives: :func:`gap_derivatives` has them)."""
+    r"""Gap :math:`g = (x_s - x_1)\cdot n` (n,) of points ``xs`` (n, 3) over the planes of triangles ``corners``
+    (n, 3, 3), and the unit normals ``n`` (n, 3); without derivatives (:func:`gap_derivatives` has them)."""
     m = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     normal = m / np.linalg.norm(m, axis=1, keepdims=True)
     return np.einsum("ij,ij->i", xs - corners[:, 0], normal), normal
