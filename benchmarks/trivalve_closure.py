@@ -53,6 +53,7 @@ OPTION_FLAGS = {
     "contact_from": (float, "step time from which the contact penalty acts"),
     "contact_exclude_within": (float, "node-face pairs closer than this (mm) in the reference never contact"),
     "contact_blend": (float, "blended contact band beta (0: closest triangle)"),
+    "contact_barrier": (float, "overlap (fraction of the search depth) from which the depth barrier acts; -1: none"),
     "contact_ramp": (float, "step-time interval over which the contact penalty rises smoothly to its value"),
     "penalty": (float, "contact penalty (MPa/mm)"),
     "cable_compression": (int, "1: cables that are one input truss carry their law in compression too"),
@@ -160,6 +161,8 @@ def main() -> int:
     overrides = {name: getattr(args, name) for name in ("end", *OPTION_FLAGS) if getattr(args, name) is not None}
     if overrides.get("max_increment") == 0.0:
         overrides["max_increment"] = None
+    if overrides.get("contact_barrier", 0.0) < 0.0:
+        overrides["contact_barrier"] = None
     if args.method == "ptc":
         options = ClosureOptions.for_relaxation(model, **overrides)
     else:

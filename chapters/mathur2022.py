@@ -621,7 +621,10 @@ if HAVE_DATA:
 #   first tries Newton's step with the full tangent and keeps it when the residual halves. Every step, damped or not,
 #   is cut where it would carry a contact node deeper than ¾ of the search depth through a leaflet
 #   (`skvalve.fem.contact_clearance`: the gap of each near node-triangle pair followed along the step; sliding is
-#   free): past that depth the penalty fades out and would let the node through. It prints all Table 2–3
+#   free): past that depth the penalty fades out and would let the node through. A node that the forces press
+#   to that floor stops every step there; `SurfaceContact(barrier=...)` (`skvalve.fem.contact_laws`) adds a log
+#   barrier that grows without bound towards the floor and so meets such a force first (off by default: on the
+#   valve, pairs already deep when the contact switches on fade out through its height). It prints all Table 2–3
 #   rows of the diseased column, with a VTU/PVD
 #   series for ParaView. The load-stepped Newton closure of this section
 #   (`run_closure`, soft chords, converged damped steps) stalls in the tethering stage of the whole valve.

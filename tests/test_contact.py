@@ -55,7 +55,8 @@ def two_blocks(n_bottom: int, n_top: int, gap: float = 0.0) -> skfem.MeshHex:
 SMOOTHING = 0.01
 
 
-def block_contact_problem(n_bottom: int, n_top: int, penalty: float, gap: float = 0.0, blend: float = 0.0):
+def block_contact_problem(n_bottom: int, n_top: int, penalty: float, gap: float = 0.0, blend: float = 0.0,
+                          barrier: float | None = None):
     mesh = two_blocks(n_bottom, n_top, gap)
     space = Space(mesh)
     problem = Problem(space, [HyperelasticTerm(space, MaterialRegions(mesh, LAW))])
@@ -63,7 +64,8 @@ def block_contact_problem(n_bottom: int, n_top: int, penalty: float, gap: float 
     facets = np.concatenate([facets, mesh.facets_satisfying(lambda X: np.abs(X[2] - 1.0 - gap) < 1e-9,
                                                             boundaries_only=True)]) if gap else facets
     surface = ContactSurface.from_facets(mesh, facets)
-    contact = problem.add_term(SurfaceContact(space, surface, penalty, smoothing=SMOOTHING, blend=blend))
+    contact = problem.add_term(SurfaceContact(space, surface, penalty, smoothing=SMOOTHING, blend=blend,
+                                                        barrier=barrier))
     problem.add_dirichlet(lambda X: X[0] == 0.0, 0.0, components=[0])
     problem.add_dirichlet(lambda X: X[1] == 0.0, 0.0, components=[1])
     problem.add_dirichlet(lambda X: X[2] == 0.0, 0.0, components=[2])

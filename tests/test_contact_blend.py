@@ -56,10 +56,11 @@ def _rough_state(problem, seed: int) -> np.ndarray:
     return u
 
 
-def test_blended_force_is_the_energy_gradient_and_the_tangent_its_derivative(monkeypatch):
+@pytest.mark.parametrize("barrier", [None, 0.0])
+def test_blended_force_is_the_energy_gradient_and_the_tangent_its_derivative(monkeypatch, barrier):
     """Central differences of the full term (search included: the blended energy is smooth) on states where
     pairs are partly shared, partly covered (past a free edge) and just above their face; the facing factors come
-    from the committed state."""
+    from the committed state. With the depth barrier from zero overlap (it then acts on every touching pair)."""
     totals = []
 
     def recorded(total, *args):
@@ -67,7 +68,7 @@ def test_blended_force_is_the_energy_gradient_and_the_tangent_its_derivative(mon
         return normalisation(total, *args)
 
     monkeypatch.setattr(contact_blend, "normalisation", recorded)
-    problem, contact = block_contact_problem(2, 3, 30.0, blend=BLEND)
+    problem, contact = block_contact_problem(2, 3, 30.0, blend=BLEND, barrier=barrier)
     h = 1e-6
     seen = {"above": 0, "shared": 0}
     for seed in (3, 5):

@@ -20,7 +20,7 @@ from skvalve.materials import NeoHookean
 GAP, PUSH, DEPTH = 0.2, 0.45, 0.1
 
 
-def _blocks():
+def _blocks(penalty: float = 50.0, barrier: float | None = None):
     """Two unit cubes (2x2x2 hexes) on rollers, GAP apart; the top one's top face pushed down PUSH (more than the
     gap plus the search depth DEPTH) from the start."""
     bottom = skfem.MeshHex.init_tensor(*(np.linspace(0, 1, 3),) * 3)
@@ -29,8 +29,8 @@ def _blocks():
     space = Space(mesh)
     problem = Problem(space, [HyperelasticTerm(space, MaterialRegions(mesh, NeoHookean(1.0, 2.0)))])
     faces = mesh.facets_satisfying(lambda X: np.isclose(X[2], 1.0) | np.isclose(X[2], 1.0 + GAP), True)
-    contact = problem.add_term(SurfaceContact(space, ContactSurface.from_facets(mesh, faces), 50.0, smoothing=0.01,
-                                              blend=0.1, max_penetration=DEPTH))
+    contact = problem.add_term(SurfaceContact(space, ContactSurface.from_facets(mesh, faces), penalty,
+                                              smoothing=0.01, blend=0.1, max_penetration=DEPTH, barrier=barrier))
     for axis in range(3):
         problem.add_dirichlet(lambda X, a=axis: X[a] == 0.0, 0.0, components=[axis])
     problem.add_dirichlet(lambda X: np.isclose(X[2], 2.0 + GAP), -PUSH, components=[2])

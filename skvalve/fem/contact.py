@@ -70,8 +70,9 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from .contact_blend import free_edges, pair_weights, sheets, weighted_mean_energy
+from .contact_blend import BARRIER_FLOOR, DEEP_FADE, free_edges, pair_weights, sheets, weighted_mean_energy
 from .contact_geometry import barycentric, barycentric_derivatives, gap_derivatives, plane_gap, smooth_step
+from .contact_laws import depth_barrier, rounded_penalty
 from .space import Space
 from .terms import Contribution, Term
 
@@ -190,6 +191,10 @@ class SurfaceContact(Term):
     blend : 0 (default) for the closest-triangle rule; a band beta in (0, 0.5] for blended contact
         (:mod:`skvalve.fem.contact_blend`: every triangle near a node takes a smooth share, no search memory, energy
         continuous with its gradient across triangle edges; ``tolerance`` is then unused).
+    barrier : ``None`` (default) for the penalty alone; a fraction :math:`h_s/g_\\text{max}` below
+        ``BARRIER_FLOOR`` (0.76) from which a log barrier adds pressure that grows without bound as the overlap nears
+        ``BARRIER_FLOOR`` :math:`g_\\text{max}`, just past the floor of the clearance limit (0.75), and fades past
+        it by the deep fade (:func:`~skvalve.fem.contact_laws.depth_barrier`).
     """
 
     name = "contact"
@@ -197,7 +202,8 @@ class SurfaceContact(Term):
 
     def __init__(self, space: Space, surface: ContactSurface, penalty, max_penetration: float | None = None,
                  exclude_rings: int = 2, opposing: float = 0.2, tolerance: float = 0.05,
-                 smoothing: float | None = None, exclude_within: float = 0.0, blend: float = 0.0) -> None:
+                 smoothing: float | None = None, exclude_within: float = 0.0, blend: float = 0.0,
+                 barrier: float | None = None) -> None:
         if space.dim != 3 or space.order != 1:
             raise ValueError("contact: needs a linear 3D displacement space")
         if surface.nodes.max() >= space.n_scalar:
@@ -223,6 +229,10 @@ class SurfaceContact(Term):
         if not (0.0 <= blend <= 0.5):
             raise ValueError(f"contact: blend must lie in [0, 0.5]; got {blend!r}")
         self.blend = float(blend)
+        if barrier is not None and not (0.0 <= barrier < BARRIER_FLOOR):
+            raise ValueError(f"contact: barrier must lie in [0, {BARRIER_FLOOR}) (a fraction of max_penetration); "
+                             f"got {barrier!r}")
+        self.barrier = None if barrier is None else float(barrier)
         self._free_edges = free_edges(surface.triangles) if self.blend > 0.0 else None
         self._reference_centroids = self.X[surface.triangles].mean(axis=1)
         self.last_pairs: ActivePairs | None = None
@@ -449,22 +459,21 @@ class SurfaceContact(Term):
         return self.last_energy
 
     def penalty_energy(self, overlap: np.ndarray, penalty: float) -> np.ndarray:
-        """Penalty energy per area psi(h) with psi' = p(h) (:meth:`pressure_law`), zero at h = 0."""
-        h0 = self.smoothing
-        if h0 == 0.0:
-            return 0.5 * penalty * overlap**2
-        return np.where(overlap < h0, penalty * overlap**3 / (6.0 * h0),
-                        penalty * (0.5 * overlap**2 - 0.5 * h0 * overlap + h0**2 / 6.0))
+        """Energy per area psi(h) with psi' = p(h) (:meth:`pressure_law`), zero at h = 0."""
+        return self._law(overlap, penalty)[0]
 
     def pressure_law(self, overlap: np.ndarray, penalty: float) -> tuple[np.ndarray, np.ndarray]:
-        """Contact pressure p(h) and dp/dh for overlaps ``h`` >= 0 (module docstring)."""
-        h0 = self.smoothing
-        if h0 == 0.0:
-            return penalty * overlap, np.full_like(overlap, penalty)
-        rounded = overlap < h0
-        pressure = np.where(rounded, penalty * overlap**2 / (2.0 * h0), penalty * (overlap - 0.5 * h0))
-        stiffness = np.where(rounded, penalty * overlap / h0, penalty)
-        return pressure, stiffness
+        """Contact pressure p(h) and dp/dh for overlaps ``h`` >= 0: the rounded penalty plus, with ``barrier``, the
+        depth barrier (:mod:`~skvalve.fem.contact_laws`)."""
+        return self._law(overlap, penalty)[1:]
+
+    def _law(self, overlap: np.ndarray, penalty: float):
+        energy, pressure, stiffness = rounded_penalty(overlap, penalty, self.smoothing)
+        if self.barrier is not None:
+            extra = depth_barrier(overlap, penalty, self.barrier * self.max_penetration,
+                                  BARRIER_FLOOR * self.max_penetration, DEEP_FADE * self.max_penetration)
+            energy, pressure, stiffness = energy + extra[0], pressure + extra[1], stiffness + extra[2]
+        return energy, pressure, stiffness
 
     # ----------------------------------------------------------------- output
     def nodal_pressure(self, u: np.ndarray, force: np.ndarray | None = None) -> np.ndarray:

@@ -49,10 +49,14 @@ from scipy.sparse.csgraph import connected_components
 
 from .contact_geometry import smooth_step
 
-__all__ = ["free_edges", "pair_weights", "sheets", "weighted_mean_energy", "DEEP_FADE", "NORMALISATION_DELTA"]
+__all__ = ["free_edges", "pair_weights", "sheets", "weighted_mean_energy", "DEEP_FADE", "BARRIER_FLOOR",
+           "NORMALISATION_DELTA"]
 
 #: The fade-in of deep pairs starts at this fraction of the search depth g_max.
 DEEP_FADE = 0.8
+#: The overlap (fraction of g_max) at which the contact's depth barrier becomes unbounded: just past the clearance
+#: limit's floor, short of the fade.
+BARRIER_FLOOR = DEEP_FADE - 0.04
 #: delta of the normalisation M(Phi) (module docstring).
 NORMALISATION_DELTA = 0.1
 

@@ -22,7 +22,9 @@ a node may slide along a sheet, come out of it or come in from the side freely, 
 three quarters of the depth, short of the fade-out. So no step carries a node from a shallower state into the
 fade-out, and the step's energy test sees the barrier. Pairs already at 0.74 of the depth or deeper are let go: a node
 that the forces hold at its floor despite the full penalty would otherwise stop every step (this happened on the 1.1
-valve), and from there on only the energy test stands in its way.
+valve), and from there on only the energy test stands in its way. With the contact's depth barrier
+(``SurfaceContact(barrier=...)``, :func:`~skvalve.fem.contact_laws.depth_barrier`) the energy itself grows without
+bound towards this floor, so the forces that press a node in are met before it gets there.
 
 Earlier rules each stopped a valve run at one node held at its floor: half the depth, with nodes already deeper held
 to their depth (a node at the edge of a band next to a free edge, 0.32 mm below it, stopped Ψtc on the 1.0 valve; one
@@ -51,7 +53,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .contact import SurfaceContact
-from .contact_blend import DEEP_FADE
+from .contact_blend import BARRIER_FLOOR
 from .contact_geometry import barycentric, plane_gap
 
 __all__ = ["clearance_fraction"]
@@ -61,7 +63,7 @@ MIN_SAMPLES = 8
 #: ... and at most this many.
 MAX_SAMPLES = 64
 #: How deep (a fraction of the search depth) a step may take a node through a triangle: short of the fade-out.
-ALLOWED_DEPTH = DEEP_FADE - 0.05  # 0.75
+ALLOWED_DEPTH = BARRIER_FLOOR - 0.01  # 0.75: the barrier's floor lies just past it
 #: A pair whose node is this deep already is let go (just short of the allowed depth: a node the forces hold at its
 #: floor would otherwise stop every step).
 RELEASED_DEPTH = ALLOWED_DEPTH - 0.01

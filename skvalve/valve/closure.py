@@ -79,6 +79,9 @@ class ClosureOptions:
     stage were rim nodes against the inner face of their own leaflet 0.5 mm away, across the 0.78 mm thick corner).
     contact_blend : 0 for closest-triangle contact; a band beta > 0 for blended contact, whose energy is continuous
     across triangle edges and has no search memory (:class:`~skvalve.fem.contact.SurfaceContact` ``blend``).
+    contact_barrier : ``None`` for the penalty alone; else the overlap (a fraction of the search depth) from which a log
+    barrier adds pressure that grows without bound towards the clearance limit's floor
+    (:class:`~skvalve.fem.contact.SurfaceContact` ``barrier``, :mod:`~skvalve.fem.contact_laws`).
     contact_ramp : the penalty rises from zero at ``contact_from`` to ``penalty`` over this step-time interval (a smooth
     step): folds that overlap when it switches on are pushed apart gradually (switched on at once, three overlapping
     pairs at the free edge of the 1.0 valve threw their nodes by millimetres and stalled the pseudo-time steps at
@@ -122,6 +125,7 @@ class ClosureOptions:
     contact_ramp: float = 0.0
     contact_exclude_within: float = 0.0
     contact_blend: float = 0.0
+    contact_barrier: float | None = None
     cable_slack_fraction: float = 1e-6
     cable_compression: bool = False
     pressure_damping: float = 1e-4
@@ -229,7 +233,7 @@ def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: Abaq
         _PenaltyFrom(options.penalty, options.contact_from, options.contact_ramp)
     contact = problem.add_term(SurfaceContact(problem.space, surface, penalty, max_penetration=depth,
                                               exclude_within=options.contact_exclude_within,
-                                              blend=options.contact_blend))
+                                              blend=options.contact_blend, barrier=options.contact_barrier))
     damping = None
     if options.damping > 0.0:
         schedule = StagedDamping(options.damping, options.pressure_damping, options.pressure_start,
