@@ -65,7 +65,7 @@ def block_contact_problem(n_bottom: int, n_top: int, penalty: float, gap: float 
                                                             boundaries_only=True)]) if gap else facets
     surface = ContactSurface.from_facets(mesh, facets)
     contact = problem.add_term(SurfaceContact(space, surface, penalty, smoothing=SMOOTHING, blend=blend,
-                                                        barrier=barrier))
+                                              barrier=barrier))
     problem.add_dirichlet(lambda X: X[0] == 0.0, 0.0, components=[0])
     problem.add_dirichlet(lambda X: X[1] == 0.0, 0.0, components=[1])
     problem.add_dirichlet(lambda X: X[2] == 0.0, 0.0, components=[2])

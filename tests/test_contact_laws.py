@@ -28,12 +28,13 @@ def barrier(h):
     return depth_barrier(h, PENALTY, START, FLOOR, SATURATE)
 
 
-def barrier_pressure(h: float) -> float:
-    """Written out here from the energy -eps (r - w)^2 ln(r / w), r = floor - h, w = floor - start: p = d psi / dh."""
-    r, w = FLOOR - h, FLOOR - START
+def log_barrier_pressure(h: float, penalty: float = PENALTY, start: float = START, floor: float = FLOOR) -> float:
+    """Written out here from the energy -eps (r - w)^2 ln(r / w), r = floor - h, w = floor - start: p = d psi / dh
+    (the log branch, before the cutoff)."""
+    r, w = floor - h, floor - start
     if r >= w:
         return 0.0
-    return PENALTY * (2.0 * (r - w) * np.log(r / w) + (r - w) ** 2 / r)
+    return penalty * (2.0 * (r - w) * np.log(r / w) + (r - w) ** 2 / r)
 
 
 def test_energy_pressure_and_stiffness_of_both_laws_are_consistent():
@@ -69,7 +70,7 @@ def test_the_barrier_starts_smoothly_and_grows_without_bound_towards_the_floor()
     assert pressure[2] == pytest.approx(3 * PENALTY * s**2 / width, rel=1e-3)
     assert stiffness[2] == pytest.approx(6 * PENALTY * s / width, rel=1e-3)
     for r in (0.5 * width, 0.1 * width, 0.02 * width):
-        assert barrier(np.array([FLOOR - r]))[1][0] == pytest.approx(barrier_pressure(FLOOR - r), rel=1e-12)
+        assert barrier(np.array([FLOOR - r]))[1][0] == pytest.approx(log_barrier_pressure(FLOOR - r), rel=1e-12)
     assert barrier(np.array([CUTOFF]))[1][0] > 0.9 * PENALTY * width / BARRIER_CUTOFF  # ~ eps w^2 / r
     with pytest.raises(ValueError, match="start < floor"):
         depth_barrier(np.zeros(1), PENALTY, FLOOR, START, SATURATE)
@@ -88,10 +89,8 @@ def closed_form_overlap(shortening: float, penalty: float, start: float, depth: 
     floor = BARRIER_FLOOR * depth
 
     def law_pressure(h):
-        r, w = floor - h, floor - start * depth
-        extra = 0.0 if r >= w else penalty * (2.0 * (r - w) * np.log(r / w) + (r - w) ** 2 / r)
         rounded = penalty * h**2 / (2 * SMOOTHING) if h < SMOOTHING else penalty * (h - 0.5 * SMOOTHING)
-        return rounded + extra
+        return rounded + log_barrier_pressure(h, penalty, start * depth, floor)
 
     def overlap_of(P):
         return brentq(lambda h: 2.0 * law_pressure(h) - P, 0.0, floor * (1 - 1e-12), xtol=1e-14)

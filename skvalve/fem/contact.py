@@ -37,7 +37,8 @@ topological neighbourhood (``exclude_rings`` rings of faces). The energy and its
 
 with the overlap :math:`h = -g`, :math:`A_s` the node's reference tributary area and :math:`p` the contact
 pressure: a penalty :math:`\varepsilon` whose first :math:`h_0` is rounded (``smoothing``) so that force and
-stiffness are continuous when a pair switches on (a kink there makes Newton chatter between active sets). With
+stiffness are continuous when a pair switches on (a kink there makes Newton chatter between active sets;
+:mod:`~skvalve.fem.contact_laws`, which also has the optional depth barrier). With
 :math:`d = x_s - x_1`, :math:`a = x_2 - x_1`, :math:`b = x_3 - x_1`, :math:`\mu = |m|`,
 :math:`P = I - n\otimes n` and :math:`w = P d/\mu`:
 
@@ -411,10 +412,10 @@ class SurfaceContact(Term):
         penalty = float(self.penalty(t))
         if self.blend > 0.0:
             return self._assemble_blended(pairs, corners, (g, grad, hess), penalty, dofs, tangent)
-        pressure, stiffness = self.pressure_law(-g, penalty)
+        energy, pressure, stiffness = self.contact_law(-g, penalty)
         area = self.area[pairs.node]
         forces = -(area * pressure)[:, None] * grad
-        self.last_energy = float(np.sum(area * self.penalty_energy(-g, penalty)))
+        self.last_energy = float(np.sum(area * energy))
         np.add.at(internal, dofs.ravel(), forces.ravel())
         self.last_force = internal[: self.space.n_u].copy()
         matrix = None
@@ -430,9 +431,8 @@ class SurfaceContact(Term):
         """Blended contact (:mod:`skvalve.fem.contact_blend`) of the candidate pairs (some above their face)."""
         g, g_grad, g_hess = gap
         overlap = np.maximum(-g, 0.0)
-        pressure, stiffness = self.pressure_law(overlap, penalty)
+        psi, pressure, stiffness = self.contact_law(overlap, penalty)
         stiffness = np.where(g < 0.0, stiffness, 0.0)  # an unrounded law has stiffness at zero overlap
-        psi = self.penalty_energy(overlap, penalty)
         psi_grad = -pressure[:, None] * g_grad
         psi_hess = None
         if tangent:
@@ -458,22 +458,15 @@ class SurfaceContact(Term):
         self.assemble(u, t, False, None)
         return self.last_energy
 
-    def penalty_energy(self, overlap: np.ndarray, penalty: float) -> np.ndarray:
-        """Energy per area psi(h) with psi' = p(h) (:meth:`pressure_law`), zero at h = 0."""
-        return self._law(overlap, penalty)[0]
-
-    def pressure_law(self, overlap: np.ndarray, penalty: float) -> tuple[np.ndarray, np.ndarray]:
-        """Contact pressure p(h) and dp/dh for overlaps ``h`` >= 0: the rounded penalty plus, with ``barrier``, the
-        depth barrier (:mod:`~skvalve.fem.contact_laws`)."""
-        return self._law(overlap, penalty)[1:]
-
-    def _law(self, overlap: np.ndarray, penalty: float):
+    def contact_law(self, overlap: np.ndarray, penalty: float):
+        """Energy per area psi(h), pressure p(h) = psi'(h) and dp/dh at overlaps ``h`` >= 0: the rounded penalty plus,
+        with ``barrier``, the depth barrier (:mod:`~skvalve.fem.contact_laws`)."""
         energy, pressure, stiffness = rounded_penalty(overlap, penalty, self.smoothing)
-        if self.barrier is not None:
-            extra = depth_barrier(overlap, penalty, self.barrier * self.max_penetration,
-                                  BARRIER_FLOOR * self.max_penetration, DEEP_FADE * self.max_penetration)
-            energy, pressure, stiffness = energy + extra[0], pressure + extra[1], stiffness + extra[2]
-        return energy, pressure, stiffness
+        if self.barrier is None:
+            return energy, pressure, stiffness
+        extra = depth_barrier(overlap, penalty, self.barrier * self.max_penetration,
+                              BARRIER_FLOOR * self.max_penetration, DEEP_FADE * self.max_penetration)
+        return energy + extra[0], pressure + extra[1], stiffness + extra[2]
 
     # ----------------------------------------------------------------- output
     def nodal_pressure(self, u: np.ndarray, force: np.ndarray | None = None) -> np.ndarray:

@@ -26,8 +26,8 @@ r"""Contact pressure laws :math:`p(h)` of an overlap :math:`h \ge 0` and their e
   pull those nodes through with newtons (209 N of residual on the 1.0 valve).
 
 Why the barrier: with the penalty alone, a force greater than about :math:`\varepsilon h_f A` on a node of tributary
-area :math:`A` (a chord's pull on a free-edge node: ~0.1 N on ~0.06 mm² against a penalty of 1 MPa/mm) holds the node
-at the floor of the clearance limit, and every further step stops there.
+area :math:`A` holds the node at the floor of the clearance limit, the step's model (which does not see the floor) keeps
+proposing to go deeper, and every further step stops there (two soft blocks show it: ``tests/test_contact_laws.py``).
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ from .contact_geometry import smooth_step
 
 __all__ = ["BARRIER_CUTOFF", "depth_barrier", "rounded_penalty"]
 
-#: The barrier continues as a quadratic below this fraction of its width r_hat.
+#: Past the clearance r = BARRIER_CUTOFF r_hat the barrier's pressure stops rising and falls to zero by ``saturate``.
 BARRIER_CUTOFF = 1e-2
 
 
