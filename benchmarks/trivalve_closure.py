@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from skvalve.fem.damping import undamped_residual
+from skvalve.fem.soft_modes import soft_modes
 from skvalve.io.abaqus import read_model, trivalve_input
 from skvalve.io.files import replace_atomically
 from skvalve.papers.mathur2022.figures import write_figures
@@ -126,6 +127,8 @@ def main() -> int:
     parser.add_argument("--resume", action="store_true", help="start from --out/last_state.npz")
     parser.add_argument("--report", action="store_true",
                         help="with --resume: measure and draw the kept state (Table 2-3 rows, figures, VTU), no solve")
+    parser.add_argument("--soft-modes", type=int, default=0, metavar="K",
+                        help="also print the K softest modes of the symmetric tangent at the end (fem.soft_modes)")
     _add_flags(parser, OPTION_FLAGS, "", "ClosureOptions.for_model")
     parser.add_argument("--hold-papillary", action="store_true",
                         help="a variant: papillary tips held where they are (no tethering), pressure stage only")
@@ -235,6 +238,8 @@ def main() -> int:
                                        mesh.t.T[:, np.argsort(ABAQUS_TO_SKFEM_HEX)])  # det(dx/dxi) at each corner
         print(f"hexes with a folded corner (corner Jacobian <= 0): {int((corners <= 0.0).any(axis=1).sum())} of "
               f"{corners.shape[0]}; smallest corner Jacobian {corners.min():.3g} (det dx/dxi)")
+        if args.soft_modes > 0:
+            _print_soft_modes(setup, run.u, t, args.soft_modes)
         ClosureWriter(args.out / "final_state.pvd", setup).write(t, run.u)
         credit = "Texas TriValve " + ("1.1" if "1.1" in str(path) else "1.0") + " (Mathur et al. 2022), " + \
                  ("CC BY 4.0" if "1.1" in str(path) else "CC BY-NC-SA 4.0")
@@ -242,6 +247,23 @@ def main() -> int:
             print(f"wrote {figure}")
     print(f"trivalve_closure_seconds={run.seconds:.1f}")
     return 0 if run.error is None else 1
+
+
+def _print_soft_modes(setup, u: np.ndarray, t: float, count: int) -> None:
+    """The ``count`` softest modes at ``u``: stiffness, residual along the mode, Newton's reach along it, and the nodes
+    it moves most with their leaflet region (-1: a chordae branch point or a node of no leaflet)."""
+    problem = setup.problem
+    modes = soft_modes(problem, u, t, k=count)
+    n_nodes = problem.space.n_scalar
+    region = np.full(n_nodes, -1)
+    region[: setup.leaflet_of_vertex.size] = setup.leaflet_of_vertex
+    print(f"softest modes of the symmetric tangent at t={t:.5g} (stiffness N/mm, residual along it N, Newton's reach "
+          "mm, the nodes it moves most with their region):")
+    for j, (value, along, reach) in enumerate(zip(modes.values, modes.residual_along, modes.newton_reach,
+                                                  strict=True)):
+        nodes = modes.moving_nodes(j, problem.space.dim, n_nodes, count=5)
+        print(f"  mode {j}: {value:.3e}  {along:+.3e}  {reach:+.3g}  nodes "
+              + ", ".join(f"{node} ({region[node]})" for node in nodes))
 
 
 if __name__ == "__main__":

@@ -29,6 +29,7 @@ from .loads import FollowerPressure, NodalForce
 from .newton import StepEvent, solve
 from .problem import Problem
 from .result import Result
+from .soft_modes import SoftModes, soft_modes
 from .solid import Solid
 from .space import Space
 from .terms import Blocks, Contribution, Term
@@ -37,5 +38,5 @@ __all__ = [
     "Solid", "Problem", "Term", "Blocks", "Contribution", "HyperelasticTerm", "MaterialRegions", "FollowerPressure",
     "NodalForce", "Result", "Space", "solve", "StepEvent", "SolverError", "ConvergenceError",
     "NonPositiveJacobianError", "SingularSystemError", "OutputError", "TangledMeshError", "SolverUnavailableError",
-    "solver_name", "available_solvers",
+    "solver_name", "available_solvers", "SoftModes", "soft_modes",
 ]
