@@ -614,8 +614,9 @@ if HAVE_DATA:
 #   exponential law into its steep part is what overshoots). At the held load the valve is still closing, through
 #   directions of negative curvature, and damped steps only creep along them; there an *energy trust region*
 #   (`skvalve.fem.trust_region`) takes over: each step's energy change is the work of the residual along it
-#   (Simpson's rule), the step matrix is the tangent with every element block (and contact patch) projected onto its
-#   positive semidefinite part plus an inertia-corrected shift, and a step is kept when the energy falls by a fair
+#   (Simpson's rule), the step matrix is the symmetric tangent plus an inertia-corrected shift (projecting every
+#   element block onto its positive semidefinite part is an option, off for the valve: it drops the curvature of the
+#   valve's softest modes, `skvalve.fem.soft_modes`), and a step is kept when the energy falls by a fair
 #   share of what its quadratic model predicts. The follower pressure on leaflets with free edges is not
 #   conservative, so close to equilibrium that energy is only approximate; below a relative residual of 1e-4 each step
 #   first tries Newton's step with the full tangent and keeps it when the residual halves. Every step, damped or not,

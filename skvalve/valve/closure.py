@@ -427,16 +427,23 @@ HELD_NEWTON_BELOW = 1e-4
 #: largest nodal motion (mm) of one held step; what keeps nodes from passing through a sheet is the clearance limit
 HELD_MAX_RADIUS = 1.0
 
+#: whether the held valve's step matrix projects the element blocks onto positive semidefinite ones: not, since from the
+#: same held 1.0 diseased state (relative residual 1.8e-3) the plain symmetric tangent with the inertia-corrected shift
+#: reached 3.0e-4 in 152 steps, the projected one no lower than 7.6e-3 in 39 (projection drops the curvature that the
+#: valve's soft modes, 3e-5 N/mm, need: :mod:`skvalve.fem.soft_modes`)
+HELD_PROJECT = False
+
 
 def held_options(setup: ClosureSetup, **overrides) -> TrustRegionOptions:
     """Trust-region controls for the held load of a valve closure: first radius a quarter of the contact search depth,
-    steps of at most ``HELD_MAX_RADIUS`` (or the depth, if larger) on any node, and ``overrides`` (e.g. ``rtol``,
+    steps of at most ``HELD_MAX_RADIUS`` (or the depth, if larger) on any node, the step matrix projected or not as
+    ``HELD_PROJECT`` says, and ``overrides`` (e.g. ``rtol``,
     ``atol``). :func:`relax_closure` also limits each step by the contact clearance
     (:func:`~skvalve.fem.contact_clearance.clearance_fraction`): a penalty energy ignores a node past the search depth,
     so a step that moved a node further than that relative to a nearby sheet could carry it through unseen."""
     depth = setup.contact.max_penetration
     return TrustRegionOptions(**{"radius": 0.25 * depth, "max_radius": max(depth, HELD_MAX_RADIUS),
-                                 "newton_below": HELD_NEWTON_BELOW, **overrides})
+                                 "newton_below": HELD_NEWTON_BELOW, "project": HELD_PROJECT, **overrides})
 
 
 def hub_relaxation(setup: ClosureSetup) -> BlockRelaxation | None:
