@@ -429,8 +429,9 @@ HELD_MAX_RADIUS = 1.0
 
 #: whether the held valve's step matrix projects the element blocks onto positive semidefinite ones: not, since from the
 #: same held 1.0 diseased state (relative residual 1.8e-3) the plain symmetric tangent with the inertia-corrected shift
-#: reached 3.0e-4 in 152 steps, the projected one no lower than 7.6e-3 in 39 (projection drops the curvature that the
-#: valve's soft modes, 3e-5 N/mm, need: :mod:`skvalve.fem.soft_modes`)
+#: reached 3.0e-4 in 152 steps, the projected one no lower than 7.6e-3 in 39; from the pressure stage's end (2.1e-3)
+#: 1.7e-3 in 194 steps with 8 rejected, the projected one none below its first step in 196 (138 rejected in its run)
+#: (projection drops the curvature that the valve's soft modes, 3e-5 N/mm, need: :mod:`skvalve.fem.soft_modes`)
 HELD_PROJECT = False
 
 
