@@ -61,8 +61,8 @@ def soft_modes(problem: Problem, u: np.ndarray, t: float, k: int = 6, seed: int 
 
     Assembles once (terms with state see ``u`` as a trial state; nothing is committed). Raises ``ValueError`` for a
     ``u`` of the wrong size or not finite, or ``k`` not below the number of free dofs; ``np.linalg.LinAlgError`` when
-    the tangent has a negative eigenvalue below the shift (the state is not a stable one: the softest mode is then a
-    descent direction, found by the trust region's shift instead).
+    the shifted tangent cannot be factorised. A negative value means the state is not a stable one: its mode is a
+    direction of descent.
     """
     n = problem.space.n_dofs
     u = np.asarray(u, dtype=float).ravel()
