@@ -74,8 +74,8 @@ def soft_modes(problem: Problem, u: np.ndarray, t: float, k: int = 6, seed: int 
         raise ValueError(f"k must be between 1 and {free.size - 1} (the free dofs less one); got {k}")
     K = problem.tangent_matrix(tangent)
     symmetric = (0.5 * (K + K.T)).tocsc()
-    diagonal = np.abs(symmetric.diagonal())
-    scale = float(diagonal.mean()) if diagonal.size and diagonal.mean() > 0.0 else 1.0
+    mean_diagonal = float(np.abs(symmetric.diagonal()).mean())  # k < free.size: never empty
+    scale = mean_diagonal if mean_diagonal > 0.0 else 1.0
     shift = -1e-9 * scale  # just below zero: zero modes factorise, and their computed eigenvalue stays ~1e-9 scale
     start = np.random.default_rng(seed).standard_normal(free.size)  # ARPACK's start vector: deterministic
     try:
