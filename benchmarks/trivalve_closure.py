@@ -109,6 +109,7 @@ TR_FLAGS = {
     "project": (int, "1: project the solid's and cables' element blocks onto positive semidefinite ones"),
     "max_steps": (int, "the most accepted trust-region steps"),
     "newton_below": (float, "relative residual below which a full-tangent Newton step is tried first (0: never)"),
+    "fit_radius": (int, "refactorisations with a raised shift for a step longer than the radius (0: scale it)"),
 }
 
 

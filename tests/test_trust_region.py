@@ -19,6 +19,7 @@ from skvalve.fem.loads import FollowerPressure
 from skvalve.fem.truss import Truss
 from skvalve.fem.trust_region import (
     TrustRegionOptions,
+    fitted_shift,
     project_psd,
     project_sparse_psd,
     step_matrix,
@@ -254,3 +255,61 @@ def test_block_relaxation_of_a_hub_keeps_it_balanced_and_the_end_state():
     with pytest.raises(ValueError, match="also acts"):
         face_node = int(np.flatnonzero(np.isclose(problem.space.mesh.p[0], 1.0))[0])  # in a hex and a cable
         BlockRelaxation(problem, problem.space.displacement_dofs(np.array([face_node])).ravel(), [truss])
+
+
+def test_fitted_shift_brings_the_node_that_moves_most_to_the_radius():
+    """A node that moves along one mode of the pencil (H, D) (a diagonal H: stiffness lambda along y) steps by
+    c/(lambda + alpha): the fitted shift is the closed form c/radius - lambda, from the step taken with any shift."""
+    lambdas = np.array([4.0, 1e-4, 2.0])
+    for shift in (0.0, 1e-3, 0.5):
+        moving = np.array([0.0, 0.3 / (1e-4 + shift), 0.0])
+        alpha = fitted_shift(moving, lambdas * moving, moving, shift, 0.05)
+        assert alpha == pytest.approx(0.3 / 0.05 - 1e-4, rel=1e-12)
+        assert 0.3 / (1e-4 + alpha) == pytest.approx(0.05, rel=1e-12)
+    assert fitted_shift(np.array([0.01, 0.0, 0.0]), np.zeros(3), np.full(3, 1.0), 0.2, 0.05) == 0.2  # never lower
+    with pytest.raises(ValueError, match="fit_radius"):
+        TrustRegionOptions(fit_radius=-1)
+
+
+def _pendulum_block(force: float = 0.002):
+    """A unit block (4x4x4 hexes) clamped at x = 0, its face x = 1 moved 0.3 along z, with a bob (a vertex of no
+    cell) hung from that face's centre by one Ogden cable and pulled sideways by a dead force: the unstressed cable
+    gives the bob no lateral stiffness, so Newton's step swings it far while the block needs a stiff correction."""
+    block = skfem.MeshHex().refined(2)
+    mesh = skfem.MeshHex(np.hstack([[[1.0], [0.5], [1.5]], block.p]), block.t + 1)  # the bob is vertex 0
+    space = Space(mesh)
+    X = mesh.p
+    centre = int(np.flatnonzero(np.all(np.isclose(X.T, [1.0, 0.5, 1.0]), axis=1))[0])
+    law = OgdenUniaxial((0.5,), (8.0,))
+    problem = Problem(space, [HyperelasticTerm(space, MaterialRegions(mesh, NeoHookean(1.0, 10.0)))])
+    problem.add_term(Truss(space, [[centre, 0]], 0.01, law))
+    problem.add_term(NodalForce(space, np.array([0]), np.array([force, 0.0, 0.0]), ramp=True))
+    cells = np.arange(X.shape[1]) >= 1
+    problem.add_dirichlet(nodes=np.flatnonzero(np.isclose(X[0], 0.0) & cells), value=0.0)
+    problem.add_dirichlet(nodes=np.flatnonzero(np.isclose(X[0], 1.0) & cells), value=np.array([0.0, 0.0, 0.3]))
+    return problem, centre, law
+
+
+def test_a_radius_fitted_shift_solves_the_stiff_part_while_a_soft_mode_swings():
+    """Scaled into the radius, Newton's step (dominated by the bob's swing) corrects the block by the same small
+    fraction and the residual stalls while the bob travels; with the shift fitted to the radius the residual falls
+    while it swings, and both runs end at the same equilibrium: the cable along the force, its tension the force
+    (closed form)."""
+    options = TrustRegionOptions(rtol=1e-10, radius=0.05, max_radius=0.1, max_steps=300)
+    runs = {}
+    for fit in (0, 3):
+        problem, centre, law = _pendulum_block()
+        runs[fit] = trust_region(problem, 1.0, np.zeros(problem.space.n_dofs), replace(options, fit_radius=fit),
+                                 progress=False)
+        assert runs[fit].converged
+    plain, fitted = runs[0], runs[3]
+    assert plain.radius_fits == 0 and fitted.radius_fits >= 5
+    assert np.abs(fitted.u - plain.u).max() <= 1e-8 * np.abs(plain.u).max()
+    assert max(plain.residuals[5:15]) >= 0.9 * plain.residuals[0]  # the plain run stalls while the bob swings
+    assert fitted.residuals[12] <= 1e-2 * plain.residuals[12]  # while the fitted one has converged nearly
+    assert len(fitted.residuals) < len(plain.residuals)
+    x = problem.space.mesh.p.T + fitted.u[: problem.space.n_u].reshape(-1, 3)
+    cable = x[0] - x[centre]
+    stretch = np.linalg.norm(cable) / 0.5
+    np.testing.assert_allclose(cable / np.linalg.norm(cable), [1.0, 0.0, 0.0], atol=1e-8)
+    assert 0.01 * law.nominal_stress(stretch)[0] == pytest.approx(0.002, rel=1e-8)

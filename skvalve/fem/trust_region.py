@@ -61,7 +61,7 @@ from .problem import Problem, Tangent
 from .ptc import _checked_edges, _limited, _stretch_changes
 
 __all__ = ["TrustRegionOptions", "TrustRegionStep", "TrustRegionResult", "trust_region", "step_matrix",
-           "project_psd", "project_sparse_psd", "work_along"]
+           "project_psd", "project_sparse_psd", "work_along", "fitted_shift"]
 
 logger = logging.getLogger("skvalve.fem")
 
@@ -98,6 +98,13 @@ class TrustRegionOptions:
         tangent, scaled into the radius, and kept when the residual norm falls below ``newton_decrease`` times its
         value (module docstring); a failed try is rewound and not repeated until the residual has halved or ten steps
         have passed.
+    fit_radius : int
+        A step longer than the radius is shortened by raising the shift :math:`\alpha` (at most this many
+        refactorisations, :func:`fitted_shift`) before what is left is scaled down; 0: scaled at once. Scaling keeps
+        the direction, which soft modes dominate (a slack chord's branch point, a free leaflet edge: Newton's step
+        moves them millimetres), so a step held to the radius corrects the stiff part of the residual only by the same
+        small fraction; the shifted step (Levenberg-Marquardt, Moré 1978) solves the stiff part and moves along the
+        soft modes only as far as the radius allows.
     rtol, atol : float
         Converged when :math:`\lVert R_f\rVert \le \max(\text{atol}, \text{rtol}\,f_\text{ref})`.
     max_steps : int
@@ -120,6 +127,7 @@ class TrustRegionOptions:
     local_decay: float = 0.5
     newton_below: float = 0.0
     newton_decrease: float = 0.5
+    fit_radius: int = 0
     rtol: float = 1e-6
     atol: float = 0.0
     max_steps: int = 500
@@ -142,6 +150,8 @@ class TrustRegionOptions:
         if not (math.isfinite(self.newton_below) and self.newton_below >= 0.0) or not 0.0 < self.newton_decrease < 1.0:
             raise ValueError("TrustRegionOptions: need newton_below >= 0 and 0 < newton_decrease < 1; got "
                              f"{self.newton_below!r}, {self.newton_decrease!r}")
+        if not (isinstance(self.fit_radius, int) and self.fit_radius >= 0):
+            raise ValueError(f"TrustRegionOptions.fit_radius must be an integer >= 0; got {self.fit_radius!r}")
         if not 0.0 < self.eta < 0.25:
             raise ValueError(f"TrustRegionOptions.eta must lie in (0, 0.25); got {self.eta!r}")
         if self.max_strain_increment is not None and not (math.isfinite(self.max_strain_increment)
@@ -189,6 +199,7 @@ class TrustRegionResult:
     newton_tries: int = 0
     rejected: int = 0
     factorizations: int = 0
+    radius_fits: int = 0
     converged: bool = False
     relative_residual: float = math.inf
     negative_eigenvalues: int | None = None
@@ -380,12 +391,22 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             if direction is None:
                 raise _give_up(result, f"no shift up to max_shift {opts.max_shift:g} gives a positive definite step "
                                        "matrix or a descent direction")
-            p = np.zeros(n)
-            p[free] = direction
-            moves = np.linalg.norm(p[: space.n_u].reshape(-1, space.dim), axis=1)
-            largest = float(moves.max(initial=0.0))
+            p = _on_all(direction, n, free)
+            largest = _largest_motion(p, space)
+            fits = result.radius_fits
+            if opts.fit_radius and largest > _FIT_ABOVE * radius:
+                clock = time.perf_counter()
+                direction, shift, newton = _fit_radius(solvers[0], H, D, -residual[free], direction, shift, newton,
+                                                       radius, space, free, opts, result)
+                if shift > 0.0:
+                    fallback = shift
+                result.timings["solve"] += time.perf_counter() - clock
+                p = _on_all(direction, n, free)
+                largest = _largest_motion(p, space)
             factor = min(1.0, radius / largest) if largest > 0.0 else 1.0
             held_by = "radius" if factor < 1.0 else "none"  # what shortened the step (verbose output)
+            if result.radius_fits > fits:
+                held_by = f"shift fitted to the radius ({result.radius_fits - fits} fits), then {held_by}"
             if edges is not None and opts.max_strain_increment is not None and edges[0].size:
                 change = float(np.max(_stretch_changes(edges[2], u, u + factor * p, edges[0], edges[1])))
                 if change > opts.max_strain_increment:
@@ -464,6 +485,71 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
         bar.close()
     return result
 
+#: a step longer than this many radii has its shift fitted (:attr:`TrustRegionOptions.fit_radius`)
+_FIT_ABOVE = 1.2
+
+
+def fitted_shift(moving: np.ndarray, stiffness: np.ndarray, scale: np.ndarray, shift: float, radius: float) -> float:
+    r"""The shift that brings a step taken with ``shift`` to ``radius``, from the node that moves most: its motion
+    ``moving`` (dim,), the rows of :math:`H p` and of :math:`D p` at that node (``stiffness``, ``scale``). With the
+    node's curvature :math:`\lambda = p_i\cdot(Hp)_i / p_i\cdot(Dp)_i` the step there scales as
+    :math:`1/(\lambda + \alpha)`, so the shift that brings its length :math:`L = |p_i|` to :math:`\Delta` is
+
+    .. math:: \alpha' = (\lambda + \alpha)\,\frac{L}{\Delta} - \lambda ,
+
+    exact when :math:`p` is a mode of the pencil :math:`(H, D)` or the node is decoupled (then for any step); never
+    below ``shift``."""
+    moving = np.asarray(moving, dtype=float)
+    curvature = max(float(moving @ stiffness) / float(moving @ scale), 0.0)
+    return max((curvature + shift) * float(np.linalg.norm(moving)) / radius - curvature, shift)
+
+
+def _fit_radius(solver, H, D, rhs, direction, shift, newton, radius, space, free, opts, result):
+    r"""Raise the shift until the step's largest nodal motion is within ``_FIT_ABOVE`` radii (at most
+    ``opts.fit_radius`` factorisations of :math:`H + \alpha D`, each checked positive definite and a descent
+    direction; :func:`fitted_shift` from the node that moves most); returns the last step found, its shift and whether
+    it is Newton's."""
+    n, dim = space.n_dofs, space.dim
+
+    def nodal(x):
+        return _on_all(x, n, free)[: space.n_u].reshape(-1, dim)
+
+    scale = D.diagonal()
+    for _ in range(opts.fit_radius):
+        moves = nodal(direction)
+        node = int(np.argmax(np.linalg.norm(moves, axis=1)))
+        if np.linalg.norm(moves[node]) <= _FIT_ABOVE * radius:
+            break
+        trial = fitted_shift(moves[node], nodal(H @ direction)[node], nodal(scale * direction)[node], shift, radius)
+        trial = min(max(trial, opts.min_shift), opts.max_shift)
+        if trial <= shift:
+            break
+        try:
+            _factorize(solver, (H + trial * D).tocsr(), result)
+            inertia = solver.inertia()
+            if inertia is not None and inertia[1] > 0:
+                break
+            x = solver.solve(rhs)
+        except np.linalg.LinAlgError:
+            break
+        if not float(rhs @ x) > 0.0:
+            break
+        result.radius_fits += 1
+        direction, shift, newton = x, trial, False
+    return direction, shift, newton
+
+
+def _largest_motion(p: np.ndarray, space) -> float:
+    """The largest nodal displacement of ``p`` (all dofs)."""
+    return float(np.linalg.norm(p[: space.n_u].reshape(-1, space.dim), axis=1).max(initial=0.0))
+
+
+def _on_all(direction: np.ndarray, n: int, free: np.ndarray) -> np.ndarray:
+    """A free-dof vector on all ``n`` dofs (zero on the prescribed ones)."""
+    p = np.zeros(n)
+    p[free] = direction
+    return p
+
 
 def _newton_try(problem, solver, K, residual, u, t, step, radius, norm, opts, result, limit):
     """Newton's step with the full tangent, scaled into ``radius``: (step, residual, tangent, trapezoidal work,
@@ -481,7 +567,7 @@ def _newton_try(problem, solver, K, residual, u, t, step, radius, norm, opts, re
         return None
     p = np.zeros_like(u)
     p[free] = direction
-    largest = float(np.linalg.norm(p[: space.n_u].reshape(-1, space.dim), axis=1).max(initial=0.0))
+    largest = _largest_motion(p, space)
     if largest > radius:
         p *= radius / largest
         largest = radius
