@@ -475,7 +475,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             shift_taken = 0.0 if newton else shift
             if ratio > 0.75:
                 shift = 0.0 if shift / 10.0 < opts.min_shift else shift / 10.0
-                if factor < 1.0:
+                if factor < 1.0 or result.radius_fits > fits:  # the radius held the step (scaled, or its shift)
                     radius = min(3.0 * radius, opts.max_radius)
             elif ratio < 0.25:
                 shift = min(max(2.0 * shift, opts.min_shift), opts.max_shift)
