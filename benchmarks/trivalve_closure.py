@@ -110,6 +110,7 @@ TR_FLAGS = {
     "max_steps": (int, "the most accepted trust-region steps"),
     "newton_below": (float, "relative residual below which a full-tangent Newton step is tried first (0: never)"),
     "fit_radius": (int, "refactorisations with a raised shift for a step longer than the radius (0: scale it)"),
+    "shift_scaling": (str, "D of the shift alpha D: diagonal (Marquardt) or uniform (Levenberg)"),
 }
 
 

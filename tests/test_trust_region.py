@@ -292,24 +292,29 @@ def _pendulum_block(force: float = 0.002):
 
 def test_a_radius_fitted_shift_solves_the_stiff_part_while_a_soft_mode_swings():
     """Scaled into the radius, Newton's step (dominated by the bob's swing) corrects the block by the same small
-    fraction and the residual stalls while the bob travels; with the shift fitted to the radius the residual falls
-    while it swings, and both runs end at the same equilibrium: the cable along the force, its tension the force
-    (closed form)."""
+    fraction and the residual stalls while the bob travels. With the shift fitted to the radius it falls while the bob
+    swings: slowly under Marquardt's diagonal shift, which damps the block's modes as much as the bob's, at once under a
+    uniform one, which damps only what is softer than the shift. All runs end at the same equilibrium: the cable along
+    the force, its tension the force (closed form)."""
     options = TrustRegionOptions(rtol=1e-10, radius=0.05, max_radius=0.1, max_steps=300)
     runs = {}
-    for fit in (0, 3):
+    for fit, scaling in ((0, "diagonal"), (3, "diagonal"), (3, "uniform")):
         problem, centre, law = _pendulum_block()
-        runs[fit] = trust_region(problem, 1.0, np.zeros(problem.space.n_dofs), replace(options, fit_radius=fit),
-                                 progress=False)
-        assert runs[fit].converged
-    plain, fitted = runs[0], runs[3]
-    assert plain.radius_fits == 0 and fitted.radius_fits >= 5
-    assert np.abs(fitted.u - plain.u).max() <= 1e-8 * np.abs(plain.u).max()
+        runs[fit, scaling] = trust_region(problem, 1.0, np.zeros(problem.space.n_dofs),
+                                          replace(options, fit_radius=fit, shift_scaling=scaling), progress=False)
+        assert runs[fit, scaling].converged
+        x = problem.space.mesh.p.T + runs[fit, scaling].u[: problem.space.n_u].reshape(-1, 3)
+        cable = x[0] - x[centre]
+        np.testing.assert_allclose(cable / np.linalg.norm(cable), [1.0, 0.0, 0.0], atol=1e-8)
+        assert 0.01 * law.nominal_stress(np.linalg.norm(cable) / 0.5)[0] == pytest.approx(0.002, rel=1e-8)
+    plain, fitted, uniform = runs[0, "diagonal"], runs[3, "diagonal"], runs[3, "uniform"]
+    assert plain.radius_fits == 0 and fitted.radius_fits >= 5 and uniform.radius_fits >= 5
+    for run in (fitted, uniform):
+        assert np.abs(run.u - plain.u).max() <= 1e-8 * np.abs(plain.u).max()
+        assert len(run.residuals) < len(plain.residuals)
     assert max(plain.residuals[5:15]) >= 0.9 * plain.residuals[0]  # the plain run stalls while the bob swings
-    assert fitted.residuals[12] <= 1e-2 * plain.residuals[12]  # while the fitted one has converged nearly
-    assert len(fitted.residuals) < len(plain.residuals)
-    x = problem.space.mesh.p.T + fitted.u[: problem.space.n_u].reshape(-1, 3)
-    cable = x[0] - x[centre]
-    stretch = np.linalg.norm(cable) / 0.5
-    np.testing.assert_allclose(cable / np.linalg.norm(cable), [1.0, 0.0, 0.0], atol=1e-8)
-    assert 0.01 * law.nominal_stress(stretch)[0] == pytest.approx(0.002, rel=1e-8)
+    assert fitted.residuals[12] <= 1e-2 * plain.residuals[12]  # while the fitted one has nearly converged
+    assert fitted.residuals[3] >= 0.3 * fitted.residuals[0]  # the diagonal shift held the block back
+    assert uniform.residuals[3] <= 0.1 * uniform.residuals[0]  # the uniform one did not
+    with pytest.raises(ValueError, match="shift_scaling"):
+        TrustRegionOptions(shift_scaling="marquardt")

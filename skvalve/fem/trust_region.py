@@ -105,6 +105,12 @@ class TrustRegionOptions:
         moves them millimetres), so a step held to the radius corrects the stiff part of the residual only by the same
         small fraction; the shifted step (Levenberg-Marquardt, Moré 1978) solves the stiff part and moves along the
         soft modes only as far as the radius allows.
+    shift_scaling : str
+        :math:`D` of the shift :math:`\alpha D`: ``"diagonal"``, the tangent's diagonal (Marquardt's scaling), or
+        ``"uniform"``, its median times the identity (Levenberg's, the scaling of the trust region itself, which bounds
+        nodal motions in length units). Under a diagonal shift every mode is damped in proportion to its own
+        stiffness, so a shift that an indefinite or very soft direction needs shortens the stiff part of the step by
+        as much; under a uniform one only the modes softer than :math:`\alpha D` are damped.
     rtol, atol : float
         Converged when :math:`\lVert R_f\rVert \le \max(\text{atol}, \text{rtol}\,f_\text{ref})`.
     max_steps : int
@@ -128,6 +134,7 @@ class TrustRegionOptions:
     newton_below: float = 0.0
     newton_decrease: float = 0.5
     fit_radius: int = 0
+    shift_scaling: str = "diagonal"
     rtol: float = 1e-6
     atol: float = 0.0
     max_steps: int = 500
@@ -150,6 +157,9 @@ class TrustRegionOptions:
         if not (math.isfinite(self.newton_below) and self.newton_below >= 0.0) or not 0.0 < self.newton_decrease < 1.0:
             raise ValueError("TrustRegionOptions: need newton_below >= 0 and 0 < newton_decrease < 1; got "
                              f"{self.newton_below!r}, {self.newton_decrease!r}")
+        if self.shift_scaling not in ("diagonal", "uniform"):
+            raise ValueError(f"TrustRegionOptions.shift_scaling must be 'diagonal' or 'uniform'; got "
+                             f"{self.shift_scaling!r}")
         if not (isinstance(self.fit_radius, int) and self.fit_radius >= 0):
             raise ValueError(f"TrustRegionOptions.fit_radius must be an integer >= 0; got {self.fit_radius!r}")
         if not 0.0 < self.eta < 0.25:
@@ -375,9 +385,9 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             symmetric_K = (0.5 * (K + K.T)).tocsr()
             H = step_matrix(problem, tangent, opts.project) if opts.project else symmetric_K
             scale = np.abs(H.diagonal())
-            floor = float(np.median(scale[scale > 0.0])) * 1e-3 if np.any(scale > 0.0) else 1.0
-            diagonal = np.maximum(scale, floor)
-            D = sp.diags(diagonal, format="csr")
+            typical = float(np.median(scale[scale > 0.0])) if np.any(scale > 0.0) else 1.0
+            diagonal = np.maximum(scale, 1e-3 * typical)
+            D = sp.diags(diagonal if opts.shift_scaling == "diagonal" else np.full(scale.size, typical), format="csr")
             model = H  # the model's Hessian: the step matrix without the shifts (the true tangent for Newton)
             if np.any(local[free] > 0.0):
                 H = (H + sp.diags(local[free] * diagonal, format="csr")).tocsr()
