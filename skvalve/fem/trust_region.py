@@ -61,7 +61,7 @@ from .problem import Problem, Tangent
 from .ptc import _checked_edges, _limited, _stretch_changes
 
 __all__ = ["TrustRegionOptions", "TrustRegionStep", "TrustRegionResult", "trust_region", "step_matrix",
-           "project_psd", "project_sparse_psd", "work_along", "fitted_shift"]
+           "project_psd", "project_sparse_psd", "work_along", "fitted_shift", "model_minimum_along"]
 
 logger = logging.getLogger("skvalve.fem")
 
@@ -111,6 +111,12 @@ class TrustRegionOptions:
         nodal motions in length units). Under a diagonal shift every mode is damped in proportion to its own
         stiffness, so a shift that an indefinite or very soft direction needs shortens the stiff part of the step by
         as much; under a uniform one only the modes softer than :math:`\alpha D` are damped.
+    extend : bool
+        A shifted step shorter than the radius is lengthened along itself to the minimum of the model
+        :math:`m(\tau p)` (at most to the radius; to the radius where the model's curvature along :math:`p` is not
+        positive). Where :math:`H` is indefinite the shift that makes :math:`H + \alpha D` definite is set by its most
+        negative direction, not by the radius, and the step it gives is shorter than the model's minimiser in the
+        region (which lies on the boundary: Moré & Sorensen 1983); the ratio test still decides.
     rtol, atol : float
         Converged when :math:`\lVert R_f\rVert \le \max(\text{atol}, \text{rtol}\,f_\text{ref})`.
     max_steps : int
@@ -135,6 +141,7 @@ class TrustRegionOptions:
     newton_decrease: float = 0.5
     fit_radius: int = 0
     shift_scaling: str = "diagonal"
+    extend: bool = False
     rtol: float = 1e-6
     atol: float = 0.0
     max_steps: int = 500
@@ -415,6 +422,9 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                 largest = _largest_motion(p, space)
             factor = min(1.0, radius / largest) if largest > 0.0 else 1.0
             held_by = "radius" if factor < 1.0 else "none"  # what shortened the step (verbose output)
+            if opts.extend and not newton and factor == 1.0 and largest > 0.0:
+                factor = model_minimum_along(residual[free], direction, model, radius / largest)
+                held_by = f"extended x{factor:.3g} to the model's minimum" if factor > 1.0 else held_by
             if result.radius_fits > fits:
                 held_by = f"shift fitted to the radius ({result.radius_fits - fits} fits), then {held_by}"
             if edges is not None and opts.max_strain_increment is not None and edges[0].size:
@@ -512,6 +522,18 @@ def fitted_shift(moving: np.ndarray, stiffness: np.ndarray, scale: np.ndarray, s
     moving = np.asarray(moving, dtype=float)
     curvature = max(float(moving @ stiffness) / float(moving @ scale), 0.0)
     return max((curvature + shift) * float(np.linalg.norm(moving)) / radius - curvature, shift)
+
+
+def model_minimum_along(residual: np.ndarray, step: np.ndarray, H: sp.spmatrix, most: float) -> float:
+    r"""The factor :math:`\tau \in [1, \text{most}]` that minimises the model
+    :math:`m(\tau p) = \tau\,R\cdot p + \tfrac12\tau^2\,p^T H p` along a descent step :math:`p`:
+    :math:`\tau^* = -R\cdot p / p^T H p`, clipped to the range, and ``most`` where the curvature is not positive."""
+    slope, curvature = float(residual @ step), float(step @ (H @ step))
+    if slope >= 0.0:
+        return 1.0
+    if curvature <= 0.0:
+        return max(most, 1.0)
+    return min(max(-slope / curvature, 1.0), max(most, 1.0))
 
 
 def _fit_radius(solver, H, D, rhs, direction, shift, newton, radius, space, free, opts, result):
