@@ -111,7 +111,7 @@ TR_FLAGS = {
     "newton_below": (float, "relative residual below which a full-tangent Newton step is tried first (0: never)"),
     "fit_radius": (int, "refactorisations with a raised shift for a step longer than the radius (0: scale it)"),
     "shift_scaling": (str, "D of the shift alpha D: diagonal (Marquardt) or uniform (Levenberg)"),
-    "extend": (int, "1: lengthen a shifted step shorter than the radius to the model's minimum along it"),
+    "project_terms": (str, "comma-separated names of terms whose element blocks are projected (e.g. chordae)"),
 }
 
 
@@ -199,9 +199,10 @@ def main() -> int:
         held = None
         if args.held == "trust-region":
             tr = {name: getattr(args, "tr_" + name) for name in TR_FLAGS if getattr(args, "tr_" + name) is not None}
-            for flag in ("project", "extend"):
-                if flag in tr:
-                    tr[flag] = bool(tr[flag])
+            if "project" in tr:
+                tr["project"] = bool(tr["project"])
+            if "project_terms" in tr:
+                tr["project_terms"] = tuple(name for name in tr["project_terms"].split(",") if name)
             held = held_options(setup, rtol=options.rtol, atol=options.atol, **tr)
             print(f"held load: {held}", flush=True)
         run = relax_closure(setup, options.end, ptc_options, callbacks=[LastState(args.out),

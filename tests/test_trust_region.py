@@ -20,7 +20,6 @@ from skvalve.fem.truss import Truss
 from skvalve.fem.trust_region import (
     TrustRegionOptions,
     fitted_shift,
-    model_minimum_along,
     project_psd,
     project_sparse_psd,
     step_matrix,
@@ -320,14 +319,3 @@ def test_a_radius_fitted_shift_solves_the_stiff_part_while_a_soft_mode_swings():
     with pytest.raises(ValueError, match="shift_scaling"):
         TrustRegionOptions(shift_scaling="marquardt")
 
-
-def test_model_minimum_along_a_step():
-    """m(tau p) = tau R.p + tau^2 p.Hp / 2 is least at tau* = -R.p / p.Hp: returned within [1, most]; the whole range
-    where the curvature along p is not positive, 1 for a step that is no descent."""
-    H = sp.diags([2.0, -1.0]).tocsr()
-    step = np.array([1.0, 0.0])
-    assert model_minimum_along(np.array([-6.0, 0.0]), step, H, 10.0) == pytest.approx(3.0, rel=1e-14)
-    assert model_minimum_along(np.array([-6.0, 0.0]), step, H, 2.5) == 2.5
-    assert model_minimum_along(np.array([-1.0, 0.0]), step, H, 10.0) == 1.0  # tau* = 1/2: never shortened
-    assert model_minimum_along(np.array([0.0, -1.0]), np.array([0.0, 1.0]), H, 7.0) == 7.0  # negative curvature
-    assert model_minimum_along(np.array([1.0, 0.0]), step, H, 7.0) == 1.0

@@ -51,7 +51,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 from tqdm.auto import tqdm
 
 from . import linsolve
@@ -59,9 +58,21 @@ from .errors import ConvergenceError, NonPositiveJacobianError
 from .newton import reference_force
 from .problem import Problem, Tangent
 from .ptc import _checked_edges, _limited, _stretch_changes
+from .trust_steps import (
+    FIT_ABOVE,
+    factorize_counted,
+    fit_radius,
+    fitted_shift,
+    largest_motion,
+    on_all_dofs,
+    project_psd,
+    project_sparse_psd,
+    shifted_direction,
+    step_matrix,
+)
 
 __all__ = ["TrustRegionOptions", "TrustRegionStep", "TrustRegionResult", "trust_region", "step_matrix",
-           "project_psd", "project_sparse_psd", "work_along", "fitted_shift", "model_minimum_along"]
+           "project_psd", "project_sparse_psd", "work_along", "fitted_shift"]
 
 logger = logging.getLogger("skvalve.fem")
 
@@ -85,6 +96,12 @@ class TrustRegionOptions:
         Project each element block of the symmetric terms (solids, trusses), and each connected block of an extra
         sparse matrix (contact), onto its positive semidefinite part in :math:`H` (the model :math:`m` of the
         steps that are not Newton's).
+    project_terms : tuple of str
+        Names of terms (``Term.name``) whose element blocks are projected even when ``project`` is off: e.g. the
+        chordae of a valve, whose compressed struts (an input truss carries its law in compression) give the
+        tangent a negative lateral stiffness :math:`-N/\ell` per strut that an unprojected step matrix must
+        out-shift, shortening every other mode's step with it, while the leaflets keep the soft curvature that
+        projection would drop.
     eta : float
         Accept a step when :math:`\rho = \Delta\Pi/m \ge \eta`.
     local_shift, local_decay : float
@@ -111,12 +128,6 @@ class TrustRegionOptions:
         nodal motions in length units). Under a diagonal shift every mode is damped in proportion to its own
         stiffness, so a shift that an indefinite or very soft direction needs shortens the stiff part of the step by
         as much; under a uniform one only the modes softer than :math:`\alpha D` are damped.
-    extend : bool
-        A shifted step shorter than the radius is lengthened along itself to the minimum of the model
-        :math:`m(\tau p)` (at most to the radius; to the radius where the model's curvature along :math:`p` is not
-        positive). Where :math:`H` is indefinite the shift that makes :math:`H + \alpha D` definite is set by its most
-        negative direction, not by the radius, and the step it gives is shorter than the model's minimiser in the
-        region (which lies on the boundary: Moré & Sorensen 1983); the ratio test still decides.
     rtol, atol : float
         Converged when :math:`\lVert R_f\rVert \le \max(\text{atol}, \text{rtol}\,f_\text{ref})`.
     max_steps : int
@@ -134,6 +145,7 @@ class TrustRegionOptions:
     min_shift: float = 1e-8
     max_shift: float = 1e8
     project: bool = True
+    project_terms: tuple[str, ...] = ()
     eta: float = 0.01
     local_shift: float = 0.1
     local_decay: float = 0.5
@@ -141,7 +153,6 @@ class TrustRegionOptions:
     newton_decrease: float = 0.5
     fit_radius: int = 0
     shift_scaling: str = "diagonal"
-    extend: bool = False
     rtol: float = 1e-6
     atol: float = 0.0
     max_steps: int = 500
@@ -221,62 +232,6 @@ class TrustRegionResult:
     relative_residual: float = math.inf
     negative_eigenvalues: int | None = None
     timings: dict[str, float] = field(default_factory=lambda: {"assembly": 0.0, "solve": 0.0})
-
-
-def project_psd(matrices: np.ndarray) -> np.ndarray:
-    """Each (m, m) block's symmetric part with its negative eigenvalues set to zero (the nearest positive
-    semidefinite matrix in the Frobenius norm)."""
-    symmetric = 0.5 * (matrices + np.swapaxes(matrices, -1, -2))
-    values, vectors = np.linalg.eigh(symmetric)
-    if np.all(values >= 0.0):
-        return symmetric
-    return np.einsum("eik,ek,ejk->eij", vectors, np.maximum(values, 0.0), vectors, optimize=True)
-
-
-def project_sparse_psd(matrix: sp.spmatrix, largest: int = 4000) -> sp.csr_matrix:
-    """The symmetric part of a sparse matrix with each connected block (the components of its pattern's graph, e.g.
-    one patch of contact pairs) projected onto its positive semidefinite part; a block of more than ``largest`` rows
-    keeps its symmetric part (a dense eigendecomposition would cost too much)."""
-    symmetric = (0.5 * (matrix + matrix.T)).tocsr()
-    symmetric.eliminate_zeros()
-    rows = np.flatnonzero(np.diff(symmetric.indptr))
-    if rows.size == 0:
-        return symmetric
-    inner = symmetric[rows][:, rows]
-    count, labels = connected_components(inner, directed=False)
-    out_rows, out_cols, out_values = [], [], []
-    order = np.argsort(labels, kind="stable")
-    bounds = np.concatenate([[0], np.cumsum(np.bincount(labels, minlength=count))])
-    for k in range(count):
-        local = order[bounds[k]: bounds[k + 1]]
-        block = inner[local][:, local].toarray()
-        if local.size <= largest:
-            values, vectors = np.linalg.eigh(block)
-            if values.min() < 0.0:
-                block = (vectors * np.maximum(values, 0.0)) @ vectors.T
-        r, c = np.meshgrid(rows[local], rows[local], indexing="ij")
-        out_rows.append(r.ravel())
-        out_cols.append(c.ravel())
-        out_values.append(block.ravel())
-    return sp.csr_matrix((np.concatenate(out_values), (np.concatenate(out_rows), np.concatenate(out_cols))),
-                         shape=matrix.shape)
-
-
-def step_matrix(problem: Problem, tangent: Tangent, project: bool) -> sp.csr_matrix:
-    """The symmetric part of the free-dof tangent; when ``project``, with the element blocks of every symmetric term
-    and the extra sparse matrices (e.g. contact: :func:`project_sparse_psd`) projected onto their positive
-    semidefinite parts (a non-symmetric term's blocks, e.g. a follower pressure's load stiffness, enter with their
-    symmetric parts: their negative curvature is the structure's response to the load, which the shift handles)."""
-
-    def blocks(term, matrices):
-        if project and getattr(term, "symmetric", True):
-            return project_psd(matrices)
-        return 0.5 * (matrices + np.swapaxes(matrices, -1, -2))
-
-    def matrix(term, sparse):
-        return project_sparse_psd(sparse) if project else 0.5 * (sparse + sparse.T)
-
-    return problem.tangent_matrix(tangent, blocks=blocks, matrix=matrix).tocsr()
 
 
 def work_along(r_start: np.ndarray, r_middle: np.ndarray, r_end: np.ndarray, step: np.ndarray) -> float:
@@ -390,7 +345,8 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                     record(step, work, math.nan, 0.0, largest, True, "newton try")
                     continue
             symmetric_K = (0.5 * (K + K.T)).tocsr()
-            H = step_matrix(problem, tangent, opts.project) if opts.project else symmetric_K
+            H = step_matrix(problem, tangent, opts.project, opts.project_terms) \
+                if opts.project or opts.project_terms else symmetric_K
             scale = np.abs(H.diagonal())
             typical = float(np.median(scale[scale > 0.0])) if np.any(scale > 0.0) else 1.0
             diagonal = np.maximum(scale, 1e-3 * typical)
@@ -400,31 +356,28 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                 H = (H + sp.diags(local[free] * diagonal, format="csr")).tocsr()
             result.timings["assembly"] += time.perf_counter() - clock
             clock = time.perf_counter()
-            direction, shift, newton = _direction(solvers, symmetric_K, K, H, D, -residual[free], shift, fallback,
-                                                  not np.any(local > 0.0), opts, result)
+            direction, shift, newton = shifted_direction(solvers, symmetric_K, K, H, D, -residual[free], shift,
+                                                         fallback, not np.any(local > 0.0), opts, result)
             if shift > 0.0:
                 fallback = shift
             result.timings["solve"] += time.perf_counter() - clock
             if direction is None:
                 raise _give_up(result, f"no shift up to max_shift {opts.max_shift:g} gives a positive definite step "
                                        "matrix or a descent direction")
-            p = _on_all(direction, n, free)
-            largest = _largest_motion(p, space)
+            p = on_all_dofs(direction, n, free)
+            largest = largest_motion(p, space)
             fits = result.radius_fits
-            if opts.fit_radius and largest > _FIT_ABOVE * radius:
+            if opts.fit_radius and largest > FIT_ABOVE * radius:
                 clock = time.perf_counter()
-                direction, shift, newton = _fit_radius(solvers[0], H, D, -residual[free], direction, shift, newton,
+                direction, shift, newton = fit_radius(solvers[0], H, D, -residual[free], direction, shift, newton,
                                                        radius, space, free, opts, result)
                 if shift > 0.0:
                     fallback = shift
                 result.timings["solve"] += time.perf_counter() - clock
-                p = _on_all(direction, n, free)
-                largest = _largest_motion(p, space)
+                p = on_all_dofs(direction, n, free)
+                largest = largest_motion(p, space)
             factor = min(1.0, radius / largest) if largest > 0.0 else 1.0
             held_by = "radius" if factor < 1.0 else "none"  # what shortened the step (verbose output)
-            if opts.extend and not newton and factor == 1.0 and largest > 0.0:
-                factor = model_minimum_along(residual[free], direction, model, radius / largest)
-                held_by = f"extended x{factor:.3g} to the model's minimum" if factor > 1.0 else held_by
             if result.radius_fits > fits:
                 held_by = f"shift fitted to the radius ({result.radius_fits - fits} fits), then {held_by}"
             if edges is not None and opts.max_strain_increment is not None and edges[0].size:
@@ -505,91 +458,13 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
         bar.close()
     return result
 
-#: a step longer than this many radii has its shift fitted (:attr:`TrustRegionOptions.fit_radius`)
-_FIT_ABOVE = 1.2
-
-
-def fitted_shift(moving: np.ndarray, stiffness: np.ndarray, scale: np.ndarray, shift: float, radius: float) -> float:
-    r"""The shift that brings a step taken with ``shift`` to ``radius``, from the node that moves most: its motion
-    ``moving`` (dim,), the rows of :math:`H p` and of :math:`D p` at that node (``stiffness``, ``scale``). With the
-    node's curvature :math:`\lambda = p_i\cdot(Hp)_i / p_i\cdot(Dp)_i` the step there scales as
-    :math:`1/(\lambda + \alpha)`, so the shift that brings its length :math:`L = |p_i|` to :math:`\Delta` is
-
-    .. math:: \alpha' = (\lambda + \alpha)\,\frac{L}{\Delta} - \lambda ,
-
-    exact when :math:`p` is a mode of the pencil :math:`(H, D)` or the node is decoupled (then for any step); never
-    below ``shift``."""
-    moving = np.asarray(moving, dtype=float)
-    curvature = max(float(moving @ stiffness) / float(moving @ scale), 0.0)
-    return max((curvature + shift) * float(np.linalg.norm(moving)) / radius - curvature, shift)
-
-
-def model_minimum_along(residual: np.ndarray, step: np.ndarray, H: sp.spmatrix, most: float) -> float:
-    r"""The factor :math:`\tau \in [1, \text{most}]` that minimises the model
-    :math:`m(\tau p) = \tau\,R\cdot p + \tfrac12\tau^2\,p^T H p` along a descent step :math:`p`:
-    :math:`\tau^* = -R\cdot p / p^T H p`, clipped to the range, and ``most`` where the curvature is not positive."""
-    slope, curvature = float(residual @ step), float(step @ (H @ step))
-    if slope >= 0.0:
-        return 1.0
-    if curvature <= 0.0:
-        return max(most, 1.0)
-    return min(max(-slope / curvature, 1.0), max(most, 1.0))
-
-
-def _fit_radius(solver, H, D, rhs, direction, shift, newton, radius, space, free, opts, result):
-    r"""Raise the shift until the step's largest nodal motion is within ``_FIT_ABOVE`` radii (at most
-    ``opts.fit_radius`` factorisations of :math:`H + \alpha D`, each checked positive definite and a descent
-    direction; :func:`fitted_shift` from the node that moves most); returns the last step found, its shift and whether
-    it is Newton's."""
-    n, dim = space.n_dofs, space.dim
-
-    def nodal(x):
-        return _on_all(x, n, free)[: space.n_u].reshape(-1, dim)
-
-    scale = D.diagonal()
-    for _ in range(opts.fit_radius):
-        moves = nodal(direction)
-        node = int(np.argmax(np.linalg.norm(moves, axis=1)))
-        if np.linalg.norm(moves[node]) <= _FIT_ABOVE * radius:
-            break
-        trial = fitted_shift(moves[node], nodal(H @ direction)[node], nodal(scale * direction)[node], shift, radius)
-        trial = min(max(trial, opts.min_shift), opts.max_shift)
-        if trial <= shift:
-            break
-        try:
-            _factorize(solver, (H + trial * D).tocsr(), result)
-            inertia = solver.inertia()
-            if inertia is not None and inertia[1] > 0:
-                break
-            x = solver.solve(rhs)
-        except np.linalg.LinAlgError:
-            break
-        if not float(rhs @ x) > 0.0:
-            break
-        result.radius_fits += 1
-        direction, shift, newton = x, trial, False
-    return direction, shift, newton
-
-
-def _largest_motion(p: np.ndarray, space) -> float:
-    """The largest nodal displacement of ``p`` (all dofs)."""
-    return float(np.linalg.norm(p[: space.n_u].reshape(-1, space.dim), axis=1).max(initial=0.0))
-
-
-def _on_all(direction: np.ndarray, n: int, free: np.ndarray) -> np.ndarray:
-    """A free-dof vector on all ``n`` dofs (zero on the prescribed ones)."""
-    p = np.zeros(n)
-    p[free] = direction
-    return p
-
-
 def _newton_try(problem, solver, K, residual, u, t, step, radius, norm, opts, result, limit):
     """Newton's step with the full tangent, scaled into ``radius``: (step, residual, tangent, trapezoidal work,
     largest nodal motion) when the residual norm falls below ``newton_decrease * norm``, else None (rewound)."""
     free, space = problem.pattern.free, problem.space
     clock = time.perf_counter()
     try:
-        _factorize(solver, K, result)
+        factorize_counted(solver, K, result)
         direction = solver.solve(-residual[free])
     except np.linalg.LinAlgError:
         return None
@@ -599,7 +474,7 @@ def _newton_try(problem, solver, K, residual, u, t, step, radius, norm, opts, re
         return None
     p = np.zeros_like(u)
     p[free] = direction
-    largest = _largest_motion(p, space)
+    largest = largest_motion(p, space)
     if largest > radius:
         p *= radius / largest
         largest = radius
@@ -624,7 +499,7 @@ def _negative_eigenvalues(solver, problem, tangent, result) -> int | None:
     """The number of negative eigenvalues of the free-dof :math:`K_s` (None where the backend gives no inertia)."""
     K = problem.tangent_matrix(tangent)
     try:
-        _factorize(solver, (0.5 * (K + K.T)).tocsr(), result)
+        factorize_counted(solver, (0.5 * (K + K.T)).tocsr(), result)
     except (np.linalg.LinAlgError, RuntimeError):
         return None
     inertia = solver.inertia()
@@ -654,52 +529,6 @@ def _residual(problem: Problem, u: np.ndarray, t: float, step: int) -> tuple[np.
     if not np.all(np.isfinite(residual)):
         raise _Attempt("the residual is not finite")
     return residual, tangent
-
-
-def _direction(solvers, symmetric_K, K, H, D, rhs, shift: float, fallback: float, newton_allowed: bool,
-               opts: TrustRegionOptions, result: TrustRegionResult):
-    """The step direction, the shift it took and whether it is Newton's.
-
-    Newton's with the full tangent when the shift is 0, no local shift is on (``newton_allowed``) and the tangent's
-    symmetric part is positive definite; else :math:`(H + \\alpha D)^{-1}` rhs with :math:`\\alpha` (from ``fallback``
-    after a Newton step was not possible) raised x8 until the matrix has no negative eigenvalue and the direction is
-    one of descent. (None, shift, False) when no shift up to ``max_shift`` gives one.
-    """
-    symmetric, definite, general = solvers
-    if shift == 0.0 and newton_allowed:
-        _factorize(definite, symmetric_K, result)
-        inertia = definite.inertia()
-        if inertia is not None and inertia[1] == 0:
-            try:
-                _factorize(general, K, result)
-                x = general.solve(rhs)
-                if float(rhs @ x) > 0.0:
-                    return x, 0.0, True
-            except np.linalg.LinAlgError:
-                pass
-    if shift == 0.0:
-        shift = max(opts.min_shift, 0.25 * fallback)
-    while shift <= opts.max_shift:
-        A = (H + shift * D).tocsr()
-        try:
-            _factorize(symmetric, A, result)
-            inertia = symmetric.inertia()
-            if inertia is None or inertia[1] == 0:
-                x = symmetric.solve(rhs)
-                if float(rhs @ x) > 0.0 and float(x @ (A @ x)) > 0.0:
-                    return x, shift, False
-        except np.linalg.LinAlgError:
-            pass
-        shift *= 8.0
-    return None, shift, False
-
-
-def _factorize(solver: linsolve.LinearSolver, matrix: sp.csr_matrix, result: TrustRegionResult) -> None:
-    csr = sp.csr_matrix(matrix)
-    csr.sort_indices()
-    solver.analyse((csr.indptr, csr.indices))
-    solver.factorize(csr.data)
-    result.factorizations += 1
 
 
 def _give_up(result: TrustRegionResult, reason: str) -> ConvergenceError:
