@@ -319,3 +319,21 @@ def test_a_radius_fitted_shift_solves_the_stiff_part_while_a_soft_mode_swings():
     with pytest.raises(ValueError, match="shift_scaling"):
         TrustRegionOptions(shift_scaling="marquardt")
 
+
+
+def test_projecting_named_terms_only():
+    """With the bob pushed towards the block (its cable compressed: negative lateral stiffness -N/l) and the block
+    unstrained (its element blocks already semidefinite), projecting the cable's blocks alone gives the fully projected
+    step matrix, and differs from the unprojected one by a positive semidefinite matrix of the cable's dofs."""
+    problem, centre, _ = _pendulum_block()
+    u = np.zeros(problem.space.n_dofs)
+    u[problem.space.displacement_dofs(np.array([0])).ravel()] = [0.0, 0.0, -0.1]  # cable stretch 0.8
+    _, tangent = problem.assemble(u, 1.0, tangent=True)
+    truss = next(term for term in problem.terms if isinstance(term, Truss))
+    named = step_matrix(problem, tangent, False, (truss.name,)).toarray()
+    everything = step_matrix(problem, tangent, True).toarray()
+    plain = step_matrix(problem, tangent, False).toarray()
+    np.testing.assert_allclose(named, everything, atol=1e-12 * np.abs(everything).max())
+    difference = named - plain
+    assert np.linalg.eigvalsh(difference).min() >= -1e-12 and np.abs(difference).max() > 1e-6
+    assert np.linalg.eigvalsh(plain).min() < 0.0 <= np.linalg.eigvalsh(named).min() + 1e-12
