@@ -437,7 +437,8 @@ HELD_PROJECT = False
 #: refactorisations with a raised shift for a held step longer than the radius, and the shift's scaling: from the same
 #: arrival state of the 1.0 diseased valve (relative residual 3.1e-3 at t = 1.5), the shift fitted to the radius
 #: under a uniform scaling reached 8.9e-4 after 80 steps and 8.4e-4 after 169, the scaled steps under Marquardt's
-#: diagonal shift 1.8e-3 after 83 (:attr:`~skvalve.fem.trust_region.TrustRegionOptions.fit_radius`, ``shift_scaling``)
+#: diagonal shift 1.8e-3 after 83 (:attr:`~skvalve.fem.trust_region.TrustRegionOptions.fit_radius`, ``shift_scaling``);
+#: neither closed the valve's centre from there (energy 8.4 and 2.5 N·mm down; projected runs: 29-35 N·mm, closed)
 HELD_FIT_RADIUS = 3
 HELD_SHIFT_SCALING = "uniform"
 
