@@ -31,15 +31,18 @@ from skvalve.valve.closure import (
     ClosureOptions,
     ClosureRun,
     closure_setup,
-    held_options,
-    relax_closure,
-    relaxation_options,
     run_closure,
     write_log,
 )
 from skvalve.valve.extrude import hex_corner_jacobians
 from skvalve.valve.model import ABAQUS_TO_SKFEM_HEX, valve_model
 from skvalve.valve.outputs import ClosureWriter, closure_measures
+from skvalve.valve.relaxation import (
+    HELD_PROJECTED_STEPS,
+    held_stages,
+    relax_closure,
+    relaxation_options,
+)
 
 #: flags that override a ClosureOptions field of the same name: type and help
 OPTION_FLAGS = {
@@ -132,6 +135,9 @@ def main() -> int:
                         help="with --resume: measure and draw the kept state (Table 2-3 rows, figures, VTU), no solve")
     parser.add_argument("--soft-modes", type=int, default=0, metavar="K",
                         help="also print the K softest modes of the symmetric tangent at the end (fem.soft_modes)")
+    parser.add_argument("--held-projected-steps", type=int, default=HELD_PROJECTED_STEPS, metavar="N",
+                        help="the held load's first stage: at most N projected steps, until its energy drop stalls "
+                             "(0: none; --tr-* flags set the last stage) (default: %(default)s)")
     _add_flags(parser, OPTION_FLAGS, "", "ClosureOptions.for_model")
     parser.add_argument("--hold-papillary", action="store_true",
                         help="a variant: papillary tips held where they are (no tethering), pressure stage only")
@@ -203,7 +209,7 @@ def main() -> int:
                 tr["project"] = bool(tr["project"])
             if "project_terms" in tr:
                 tr["project_terms"] = tuple(name for name in tr["project_terms"].split(",") if name)
-            held = held_options(setup, rtol=options.rtol, atol=options.atol, **tr)
+            held = held_stages(setup, args.held_projected_steps, rtol=options.rtol, atol=options.atol, **tr)
             print(f"held load: {held}", flush=True)
         run = relax_closure(setup, options.end, ptc_options, callbacks=[LastState(args.out),
                                                                          BestState(args.out, options.end)],

@@ -606,7 +606,7 @@ if HAVE_DATA:
 #
 # * `skvalve reproduce mathur2022` compares the orifice and leaflet areas of the open configuration with Table 2
 #   (minutes); `skvalve reproduce mathur2022 --full --out out/` runs the implicit closure of the whole diseased valve
-#   with leaflet contact (`skvalve.valve.closure.relax_closure`: all three leaflets, 690 cables at their full law,
+#   with leaflet contact (`skvalve.valve.relaxation.relax_closure`: all three leaflets, 690 cables at their full law,
 #   those that are one input truss also in compression, as the input's trusses are,
 #   `SurfaceContact` on the input's contact surfaces) by *pseudo-transient continuation* (`skvalve.fem.ptc`): one
 #   damped, linearised implicit-Euler step per pseudo-time step, no equilibrium asked for on the way, trust regions

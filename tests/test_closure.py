@@ -1,6 +1,7 @@
 """The closure driver (skvalve.valve.closure) on a small contact problem, and its contact surface and staging on
 the shipped diseased Texas TriValve input (skipped when the input is absent)."""
 
+from dataclasses import replace
 from types import SimpleNamespace
 
 import meshio
@@ -9,6 +10,7 @@ import pytest
 import skfem
 
 from skvalve.fem import Problem, Space
+from skvalve.fem.amplitudes import SmoothStep
 from skvalve.fem.constitutive import MaterialRegions
 from skvalve.fem.contact import ContactSurface, SurfaceContact
 from skvalve.fem.damping import DampingSchedule, ViscousDamping
@@ -21,16 +23,18 @@ from skvalve.papers.mathur2022 import reproduce as reproduce_module
 from skvalve.valve.closure import (
     ClosureOptions,
     ClosureSetup,
-    EveryLoadFactor,
     _PenaltyFrom,
     contact_surface,
     load_factors,
-    relax_closure,
-    relaxation_options,
     run_closure,
 )
 from skvalve.valve.model import valve_model
 from skvalve.valve.outputs import ClosureWriter
+from skvalve.valve.relaxation import (
+    EveryLoadFactor,
+    relax_closure,
+    relaxation_options,
+)
 
 
 def _blocks_setup(shortening: float, damped: bool = True, blend: float = 0.0) -> ClosureSetup:
@@ -104,6 +108,25 @@ def test_a_trust_region_at_the_held_load_ends_where_the_load_stepped_closure_doe
     assert relaxed.contact_pairs[-1] == newton.contact_pairs[-1] == 18
     np.testing.assert_allclose(relaxed.u, newton.u, atol=1e-8)
     assert relaxed.undamped_residual[1] < 1e-9
+
+
+def test_held_stages_hand_on_their_state_and_end_where_one_stage_does():
+    """Held stages (``held`` a sequence): a first stage of projected steps that passes its ``max_steps`` hands its last
+    state to the next, which ends at the equilibrium of the damped Newton load steps; the run records each stage's
+    steps. A failing last stage is the run's error."""
+    options = ClosureOptions(papillary_steps=2, pressure_steps=2, rtol=1e-9, solver="scipy")
+    newton = run_closure(_blocks_setup(0.15, blend=0.1), options, progress=False)
+    ptc = PseudoTransientOptions(damping=0.5, first_step=0.05, max_load_step=0.25, rtol=1e-9, solver="scipy")
+    stages = [TrustRegionOptions(rtol=1e-9, solver="scipy", project=True, max_steps=1),
+              TrustRegionOptions(rtol=1e-9, solver="scipy")]
+    staged = relax_closure(_blocks_setup(0.15, damped=False, blend=0.1), 1.5, ptc, progress=False, held=stages)
+    assert staged.error is None and len(staged.stage_steps) == 2 and staged.stage_steps[0] == 1
+    assert staged.stage_steps[1] >= 1
+    np.testing.assert_allclose(staged.u, newton.u, atol=1e-8)
+    assert staged.undamped_residual[1] < 1e-9
+    failing = relax_closure(_blocks_setup(0.15, damped=False, blend=0.1), 1.5, ptc, progress=False,
+                            held=[stages[0], replace(stages[1], max_steps=1)])
+    assert failing.error is not None and "1 steps without converging" in failing.error
 
 
 def test_contact_pairs_closer_than_exclude_within_in_the_reference_are_never_active():
@@ -243,10 +266,6 @@ def test_a_resumed_closure_ends_where_an_uninterrupted_one_does():
 def test_options_fitted_to_the_staging_of_an_input():
     """1.0 inputs: papillary motion over 0-0.5, pressure over 0.5-1.5; the 1.1 healthy input ramps everything over
     0-1 (no papillary stage, no soft start of the cables)."""
-    from types import SimpleNamespace
-
-    from skvalve.fem.amplitudes import SmoothStep
-
     def stub(start, end):
         pressure = SimpleNamespace(amplitude=SmoothStep((start, end), (0.0, 1.0), "Amp-1"))
         return SimpleNamespace(pressures=[pressure], end_time=end)

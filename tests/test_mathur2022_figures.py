@@ -161,8 +161,10 @@ def test_reproduce_full_writes_the_figures_of_the_last_state(setup, tmp_path, mo
     module = reproduce_module
 
     def stopped(setup, end, options, callbacks=(), progress=True, held=None):
-        assert held is not None and held.radius == 0.25 * setup.contact.max_penetration  # held: the trust region
-        assert held.newton_below > 0.0
+        first, last = held  # held: the trust region's stages, projected steps first
+        assert first.project and first.stall_fraction > 0.0 and not last.project
+        assert first.radius == last.radius == 0.25 * setup.contact.max_penetration
+        assert last.newton_below > 0.0
         return ClosureRun(load_factors=[0.0], iterations=[0], contact_pairs=[0],
                           u=np.zeros(setup.problem.space.n_dofs), error="stopped for the test")
 

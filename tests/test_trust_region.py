@@ -337,3 +337,28 @@ def test_projecting_named_terms_only():
     difference = named - plain
     assert np.linalg.eigvalsh(difference).min() >= -1e-12 and np.abs(difference).max() > 1e-6
     assert np.linalg.eigvalsh(plain).min() < 0.0 <= np.linalg.eigvalsh(named).min() + 1e-12
+
+
+def test_a_stalled_stage_stops_where_its_energy_drop_falls_off_and_the_next_one_ends_at_the_same_equilibrium():
+    """The pendulum block with scaled steps: its energy falls by about the same amount per step while the bob swings
+    within the radius, then by less and less. With ``stall_fraction`` the region stops at the first step whose last
+    ``stall_window`` drops average below that fraction of all its drops (found here from the full run's drops), on the
+    full run's path; relaxed on from there, it ends at the full run's equilibrium."""
+    options = TrustRegionOptions(rtol=1e-10, radius=0.05, max_radius=0.1, max_steps=300)
+    problem, _, _ = _pendulum_block()
+    full = trust_region(problem, 1.0, np.zeros(problem.space.n_dofs), options, progress=False)
+    drops = -np.asarray(full.energy_changes)
+    window, fraction = 5, 0.2
+    stop = next(k for k in range(window, drops.size + 1) if drops[k - window:k].mean() < fraction * drops[:k].mean())
+    assert window < stop < drops.size  # the test has a stop to find before the run converges
+    problem, _, _ = _pendulum_block()
+    staged = trust_region(problem, 1.0, np.zeros(problem.space.n_dofs),
+                          replace(options, stall_fraction=fraction, stall_window=window), progress=False)
+    assert staged.stalled and not staged.converged and len(staged.residuals) == stop
+    np.testing.assert_allclose(staged.energy_changes, full.energy_changes[:stop], rtol=1e-8, atol=1e-14)
+    rest = trust_region(problem, 1.0, staged.u, options, progress=False)
+    assert rest.converged and not rest.stalled
+    assert np.abs(rest.u - full.u).max() <= 1e-8 * np.abs(full.u).max()
+    for bad in ({"stall_fraction": 1.0}, {"stall_fraction": -0.1}, {"stall_window": 1}):
+        with pytest.raises(ValueError, match="stall"):
+            TrustRegionOptions(**bad)

@@ -132,6 +132,12 @@ class TrustRegionOptions:
         Converged when :math:`\lVert R_f\rVert \le \max(\text{atol}, \text{rtol}\,f_\text{ref})`.
     max_steps : int
         The most accepted steps.
+    stall_fraction, stall_window : float, int
+        With ``stall_fraction`` > 0 the relaxation returns unconverged, with ``stalled`` set, once the energy drop
+        averaged over the last ``stall_window`` accepted steps is below ``stall_fraction`` of its average over all of
+        them (scale-free: the same test for any valve or load). It ends a stage of a staged relaxation
+        (:func:`~skvalve.valve.relaxation.relax_closure`), e.g. projected steps that carry a structure a long way down
+        its energy and no longer do once it is there.
     solver : str or None
         Sparse backend (:func:`skvalve.fem.linsolve.solver_name`); PARDISO reports the inertia, SuperLU does not
         (then :math:`\alpha` rises only when a step is not a descent direction of the model).
@@ -156,6 +162,8 @@ class TrustRegionOptions:
     rtol: float = 1e-6
     atol: float = 0.0
     max_steps: int = 500
+    stall_fraction: float = 0.0
+    stall_window: int = 20
     solver: str | None = None
 
     def __post_init__(self) -> None:
@@ -190,6 +198,9 @@ class TrustRegionOptions:
             raise ValueError(f"TrustRegionOptions.atol must be finite and >= 0; got {self.atol!r}")
         if not (isinstance(self.max_steps, int) and self.max_steps > 0):
             raise ValueError(f"TrustRegionOptions.max_steps must be a positive integer; got {self.max_steps!r}")
+        if not (0.0 <= self.stall_fraction < 1.0) or not (isinstance(self.stall_window, int) and self.stall_window > 1):
+            raise ValueError("TrustRegionOptions: need 0 <= stall_fraction < 1 and an integer stall_window > 1; got "
+                             f"{self.stall_fraction!r}, {self.stall_window!r}")
 
 
 @dataclass
@@ -229,6 +240,7 @@ class TrustRegionResult:
     factorizations: int = 0
     radius_fits: int = 0
     converged: bool = False
+    stalled: bool = False
     relative_residual: float = math.inf
     negative_eigenvalues: int | None = None
     timings: dict[str, float] = field(default_factory=lambda: {"assembly": 0.0, "solve": 0.0})
@@ -259,9 +271,9 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
     it applies to Newton tries too.
 
     ``edges``/``rest_lengths`` as in :func:`~skvalve.fem.ptc.pseudo_transient`. Returns a :class:`TrustRegionResult`
-    with ``converged`` set; raises :class:`~skvalve.fem.errors.ConvergenceError` (``error.last_state``: the result up
-    to the last accepted step) when the radius falls below ``min_radius``, the shift passes ``max_shift`` or
-    ``max_steps`` pass.
+    with ``converged`` (or ``stalled``: :attr:`TrustRegionOptions.stall_fraction`) set; raises
+    :class:`~skvalve.fem.errors.ConvergenceError` (``error.last_state``: the result up to the last accepted step) when
+    the radius falls below ``min_radius``, the shift passes ``max_shift`` or ``max_steps`` pass.
     """
     opts = options or TrustRegionOptions()
     if not math.isfinite(t):
@@ -454,9 +466,21 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                 shift = min(max(2.0 * shift, opts.min_shift), opts.max_shift)
                 radius = max(0.5 * largest, opts.min_radius)
             record(step, work, ratio, shift_taken, largest, newton, held_by)
+            if _stalled(result.energy_changes, opts):
+                result.stalled = True
+                break
     finally:
         bar.close()
     return result
+
+def _stalled(energy_changes: list[float], opts: TrustRegionOptions) -> bool:
+    """Whether the energy drop of the last ``stall_window`` steps averages below ``stall_fraction`` of its average
+    over all steps (:class:`TrustRegionOptions`)."""
+    if opts.stall_fraction <= 0.0 or len(energy_changes) < opts.stall_window:
+        return False
+    drops = -np.asarray(energy_changes)
+    return float(drops[-opts.stall_window:].mean()) < opts.stall_fraction * float(drops.mean())
+
 
 def _newton_try(problem, solver, K, residual, u, t, step, radius, norm, opts, result, limit):
     """Newton's step with the full tangent, scaled into ``radius``: (step, residual, tangent, trapezoidal work,

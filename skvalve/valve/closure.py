@@ -14,38 +14,32 @@ input: papillary-muscle motion (``Amp-2``, smooth step over 0–0.5) then the tr
   undamped residual there is reported (:attr:`ClosureRun.undamped_residual`).
 
 Every converged step goes to the callbacks (VTU series of :mod:`.outputs`); a failed step raises the
-solver's error with step and load factor, carrying the converged steps (``error.last_converged``).
+solver's error with step and load factor, carrying the converged steps (``error.last_converged``). The route the
+valve runs take, relaxation without Newton's load steps, is :mod:`.relaxation`.
 """
 
 from __future__ import annotations
 
-import math
 import resource
 import time
-from dataclasses import dataclass, field, replace
-from functools import partial
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ..fem.amplitudes import GeometricRamp, smooth_step_polynomial
-from ..fem.block_relaxation import BlockRelaxation
 from ..fem.contact import SurfaceContact
-from ..fem.contact_clearance import clearance_fraction
 from ..fem.damping import ViscousDamping, lumped_volume, undamped_residual
 from ..fem.newton import StepEvent, solve
 from ..fem.problem import Problem
-from ..fem.ptc import PseudoTransientOptions, pseudo_transient
 from ..fem.truss import Truss
-from ..fem.trust_region import TrustRegionOptions, trust_region
 from ..io.abaqus import AbaqusModel, read_model, trivalve_input
 from ..io.files import replace_atomically
 from .model import ValveModel, valve_model
 from .surfaces import contact_surface, thinnest_stack
 
-__all__ = ["ClosureOptions", "ClosureSetup", "ClosureRun", "EveryLoadFactor", "StagedDamping",
-           "closure_setup", "contact_surface", "damping_weights", "held_options", "hub_relaxation", "load_factors",
-           "relax_closure", "relaxation_options", "run_closure", "watched_edges"]
+__all__ = ["ClosureOptions", "ClosureSetup", "ClosureRun", "StagedDamping", "closure_setup", "contact_surface",
+           "damping_weights", "load_factors", "run_closure"]
 
 
 @dataclass
@@ -132,17 +126,17 @@ class ClosureOptions:
 
     @classmethod
     def for_relaxation(cls, model: ValveModel, **overrides) -> ClosureOptions:
-        """:meth:`for_model` set up for :func:`relax_closure`: no damping term (the solver damps), the chordae at
-        their full law from the start (no soft start: the pseudo-transient steps follow the tips without it), the
-        contact penalty switched on by a smooth step over 0.1 of step time from the pressure's start (from the start
+        """:meth:`for_model` set up for :func:`.relaxation.relax_closure`: no damping term (the solver damps), the
+        chordae at their full law from the start (no soft start: the pseudo-transient steps follow the tips without it),
+        the contact penalty switched on by a smooth step over 0.1 of step time from the pressure's start (from the start
         instead, one rim node of the 1.0 diseased valve, paired with its own leaflet 3.3 mm away, throttled the
         papillary stage to pseudo-steps of 1e-5 by its edges' stretch limit), no contact between skins that are less
-        than 1 mm apart in the reference (more than the 0.78 mm leaflet thickness), the single input trusses
-        carrying their law in compression as the input's do (``cable_compression``: the fans of single trusses at the
-        chordae branch points are then struts, not mechanisms held by slack springs), and blended contact
-        (``contact_blend`` 0.1: on the 1.0 diseased valve the closest-triangle rule left 64 % of the held residual's
-        square on one crease of the septal leaflet, 50 % of it on two nodes; blended from the pressure's start, 0.4 %
-        on contact nodes, half of it spread over 2873 nodes)."""
+        than 1 mm apart in the reference (more than the 0.78 mm leaflet thickness), the single input trusses carrying
+        their law in compression as the input's do (``cable_compression``: the fans of single trusses at the chordae
+        branch points are then struts, not mechanisms held by slack springs), and blended contact (``contact_blend``
+        0.1: on the 1.0 diseased valve the closest-triangle rule left 64 % of the held residual's square on one crease
+        of the septal leaflet, 50 % of it on two nodes; blended from the pressure's start, 0.4 % on contact nodes, half
+        of it spread over 2873 nodes)."""
         fitted = {"damping": 0.0, "cable_softening": 1.0, "contact_ramp": 0.1, "contact_exclude_within": 1.0,
                   "cable_compression": True, "contact_blend": 0.1}
         fitted.update(overrides)
@@ -193,6 +187,8 @@ class ClosureRun:
     timings: dict[str, float] = field(default_factory=dict)
     #: negative eigenvalues of the symmetric tangent at the converged held state (trust region with PARDISO)
     negative_eigenvalues: int | None = None
+    #: accepted steps of each held stage (:func:`.relaxation.relax_closure` with a sequence of trust-region options)
+    stage_steps: list[int] = field(default_factory=list)
 
 
 def load_factors(options: ClosureOptions) -> np.ndarray:
@@ -294,194 +290,6 @@ def run_closure(setup: ClosureSetup, options: ClosureOptions | None = None, call
     if run.u is not None:
         run.undamped_residual = undamped_residual(setup.problem, run.u, run.load_factors[-1])
     return run
-
-
-def relaxation_options(pressure_start: float = 0.5, **overrides) -> list[tuple[float, PseudoTransientOptions]]:
-    """Pseudo-transient stages for the Texas TriValve closure (units mm, MPa, step time), found on the 1.0 diseased
-    valve, as ``(until, options)`` for :func:`relax_closure`. Both: damping 1e-5 per lumped volume, load steps of at
-    most 0.005 (the tips move up to 0.25 mm per step), 0.5 mm trust region on any node.
-
-    * up to ``pressure_start`` (the papillary tips move): a trust region of 0.05 on any edge's or cable's tensile
-      stretch per step, nothing else (larger regions let the hexes next to the insertions reach states that lose
-      stability through the thickness; stiffness-proportional or local damping hold the stiff chords back against
-      the moving tips, whose forces then grow to newtons);
-    * after (the pressure): a trust region of 0.2, a stiffness-proportional damping of 1e-3 while the pressure rises
-      (1e-4 let the stage crawl at steps of ~4e-4: the overshoots are where the exponential laws are stiff) and none
-      once it is held (kept, it holds the leaflets' soft modes back: from a 1.0 diseased end state at relative
-      residual 3.07e-3, 34 held steps with it left 3.07e-3, 7 without reached 1.3e-3 and 125 a best of 8.7e-4), local
-      damping (x10) of the nodes that break a trust region, and ``overrides`` (e.g. ``rtol``, ``atol`` of the end
-      state).
-
-    The first stage ends on a loose relative residual (1e-3): its end state only starts the second.
-    """
-    common = {"damping": 1e-5, "max_load_step": 0.005, "first_step": 5e-4, "max_increment": 0.5}
-    stages = []
-    if pressure_start > 0.0:
-        stages.append((pressure_start, PseudoTransientOptions(**common, max_strain_increment=0.05, rtol=1e-3)))
-    fitted = {**common, "max_strain_increment": 0.2, "stiffness_damping": 1e-3, "held_stiffness_damping": 0.0,
-              "local_damping": 10.0}
-    fitted.update(overrides)
-    stages.append((math.inf, PseudoTransientOptions(**fitted)))
-    return stages
-
-
-class EveryLoadFactor:
-    """A callback passed on only when the load factor enters a new multiple of ``spacing`` (pseudo-transient runs take
-    hundreds of steps; a VTU series wants tens)."""
-
-    def __init__(self, callback, spacing: float = 0.05) -> None:
-        if not spacing > 0.0:
-            raise ValueError(f"spacing must be positive; got {spacing!r}")
-        self.callback, self.spacing, self.last = callback, float(spacing), None
-
-    def __call__(self, event) -> None:
-        bucket = int(np.floor(event.load_factor / self.spacing + 1e-9))
-        if self.last is None or bucket > self.last:
-            self.last = bucket
-            self.callback(event)
-
-
-def relax_closure(setup: ClosureSetup, end: float,
-                  options: PseudoTransientOptions | list[tuple[float, PseudoTransientOptions]] | None = None,
-                  callbacks=(), progress: bool = True, verbose: bool = False, u0: np.ndarray | None = None,
-                  t0: float = 0.0, held: TrustRegionOptions | None = None) -> ClosureRun:
-    """The closure by pseudo-transient continuation (:func:`~skvalve.fem.ptc.pseudo_transient`): one damped,
-    linearised step per pseudo-time step, no equilibrium asked for on the way, relaxed at ``end`` to the undamped
-    equilibrium. ``setup`` must have no damping term (``ClosureOptions(damping=0)``): the damping is the
-    solver's, with :func:`damping_weights`. ``options``: one set, or stages ``(until, options)`` run one after the
-    other (:func:`relaxation_options`). ``held``: relax at the held load with the energy trust region
-    (:func:`~skvalve.fem.trust_region.trust_region`, with the chordae branch points relaxed after each step:
-    :func:`hub_relaxation`) instead, from the first state Ψtc reaches there (its last stage then stops as soon as the
-    load is held, once its relative residual is below 1). Ψtc's and the trust region's steps are both limited by the
-    contact clearance (:func:`~skvalve.fem.contact_clearance.clearance_fraction`). Never raises for a failed run:
-    the error and the kept state are recorded (the last accepted one; after Ψtc gave up at the held load, the held
-    state with the smallest residual).
-    """
-    if setup.damping is not None:
-        raise ValueError("relax_closure damps through the solver: build the setup with ClosureOptions(damping=0)")
-    options = options or PseudoTransientOptions()
-    stages = [(math.inf, options)] if isinstance(options, PseudoTransientOptions) else list(options)
-    run = ClosureRun()
-
-    def record(event) -> None:
-        run.load_factors.append(float(event.load_factor))
-        run.iterations.append(1)
-        run.contact_pairs.append(setup.contact.last_pairs.touching if setup.contact.last_pairs is not None else 0)
-        run.u = event.u
-
-    edges, rest_lengths = watched_edges(setup.model) if setup.model is not None else (None, None)
-    weights = damping_weights(setup.problem.space)
-    clearance = partial(clearance_fraction, setup.contact)
-    start = time.perf_counter()
-    result = None
-
-    def add_effort(stage_result) -> None:
-        counts = [("rejected_steps", stage_result.rejected)]
-        if hasattr(stage_result, "newton_tries"):
-            counts += [("newton_tries", stage_result.newton_tries), ("newton_steps", stage_result.newton_steps)]
-        for key, value in (*stage_result.timings.items(), *((name, float(count)) for name, count in counts)):
-            run.timings[key] = run.timings.get(key, 0.0) + value
-
-    try:
-        for until, stage in stages:
-            stop = min(until, end)
-            if stop <= t0 and until < end:
-                continue
-            if held is not None and stop >= end:  # Ψtc only brings the load to its end
-                stage = replace(stage, rtol=1.0)
-            result = pseudo_transient(setup.problem, weights, stop, stage, u0=u0, t0=t0, edges=edges,
-                                      rest_lengths=rest_lengths, callbacks=[record, *callbacks], progress=progress,
-                                      verbose=verbose, limit=clearance)
-            add_effort(result)
-            u0, t0 = result.u, result.load_factor
-            if stop >= end:
-                break
-        if held is not None:
-            hubs = hub_relaxation(setup) if setup.model is not None else None
-            result = trust_region(setup.problem, end, u0, held, edges=edges, rest_lengths=rest_lengths,
-                                  callbacks=[record, *callbacks], progress=progress, verbose=verbose, relax=hubs,
-                                  limit=clearance)
-            add_effort(result)
-            run.negative_eigenvalues = result.negative_eigenvalues
-    except Exception as err:  # noqa: BLE001 - a failed closure is a result to report, with its last state
-        run.error = f"{type(err).__name__}: {err}"
-        result = getattr(err, "last_state", None)
-        if result is not None:  # the failed stage's effort, and its kept state (the best one at the held load)
-            add_effort(result)
-            run.u = result.u
-    finally:
-        run.peak_memory_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: kB
-        run.seconds = time.perf_counter() - start
-    if result is not None and run.error is None and not result.converged:
-        run.error = "did not converge"
-    if run.u is not None:
-        run.undamped_residual = undamped_residual(setup.problem, run.u, run.load_factors[-1])
-    return run
-
-
-#: relative residual below which the held valve's steps first try full-tangent Newton (the follower pressure on
-#: leaflets with free edges has a non-symmetric load stiffness, so the energy model is not exact near equilibrium)
-HELD_NEWTON_BELOW = 1e-4
-
-
-#: largest nodal motion (mm) of one held step; what keeps nodes from passing through a sheet is the clearance limit
-HELD_MAX_RADIUS = 1.0
-
-#: whether the held valve's step matrix projects the element blocks onto positive semidefinite ones: not, since from the
-#: same held 1.0 diseased state (relative residual 1.8e-3) the plain symmetric tangent with the inertia-corrected shift
-#: reached 3.0e-4 in 152 steps, the projected one no lower than 7.6e-3 in 39; from the pressure stage's end (2.1e-3)
-#: 1.7e-3 in 194 steps with 8 rejected, the projected one none below its first step in 196 (138 rejected in its run)
-#: (projection drops the curvature that the valve's soft modes, 3e-5 N/mm, need: :mod:`skvalve.fem.soft_modes`)
-HELD_PROJECT = False
-
-#: refactorisations with a raised shift for a held step longer than the radius, and the shift's scaling: from the same
-#: arrival state of the 1.0 diseased valve (relative residual 3.1e-3 at t = 1.5), the shift fitted to the radius
-#: under a uniform scaling reached 8.9e-4 after 80 steps and 8.4e-4 after 169, the scaled steps under Marquardt's
-#: diagonal shift 1.8e-3 after 83 (:attr:`~skvalve.fem.trust_region.TrustRegionOptions.fit_radius`, ``shift_scaling``);
-#: neither closed the valve's centre from there (energy 8.4 and 2.5 N·mm down; projected runs: 29-35 N·mm, closed)
-HELD_FIT_RADIUS = 3
-HELD_SHIFT_SCALING = "uniform"
-
-
-def held_options(setup: ClosureSetup, **overrides) -> TrustRegionOptions:
-    """Trust-region controls for the held load of a valve closure: first radius a quarter of the contact search depth,
-    steps of at most ``HELD_MAX_RADIUS`` (or the depth, if larger) on any node, the step matrix projected or not as
-    ``HELD_PROJECT`` says, a step longer than the radius shortened by a uniform shift fitted to it
-    (``HELD_FIT_RADIUS``, ``HELD_SHIFT_SCALING``), and ``overrides`` (e.g. ``rtol``,
-    ``atol``). :func:`relax_closure` also limits each step by the contact clearance
-    (:func:`~skvalve.fem.contact_clearance.clearance_fraction`): a penalty energy ignores a node past the search depth,
-    so a step that moved a node further than that relative to a nearby sheet could carry it through unseen."""
-    depth = setup.contact.max_penetration
-    return TrustRegionOptions(**{"radius": 0.25 * depth, "max_radius": max(depth, HELD_MAX_RADIUS),
-                                 "newton_below": HELD_NEWTON_BELOW, "project": HELD_PROJECT,
-                                 "fit_radius": HELD_FIT_RADIUS, "shift_scaling": HELD_SHIFT_SCALING, **overrides})
-
-
-def hub_relaxation(setup: ClosureSetup) -> BlockRelaxation | None:
-    """The chordae branch points (vertices of no leaflet cell, not prescribed) brought to equilibrium with the rest
-    held, by the cables alone (:mod:`skvalve.fem.block_relaxation`); None when the model has none."""
-    mesh = setup.model.mesh
-    in_cell = np.zeros(mesh.p.shape[1], dtype=bool)
-    in_cell[np.unique(mesh.t)] = True
-    hubs = np.flatnonzero(~in_cell)
-    trusses = [term for term in setup.problem.terms if isinstance(term, Truss)]
-    if hubs.size == 0 or not trusses:
-        return None
-    relax = BlockRelaxation(setup.problem, setup.problem.space.displacement_dofs(hubs).ravel(), trusses)
-    return relax if relax.dofs.size else None
-
-
-def watched_edges(model: ValveModel) -> tuple[np.ndarray, np.ndarray]:
-    """Node pairs whose tensile stretch the pseudo-transient trust region limits, and the lengths from which they
-    carry tension: every pair of a hex's vertices (edges and diagonals, whatever the vertex order; their reference
-    lengths) and the cables (their rest lengths)."""
-    hexes = model.mesh.t.T
-    pairs = [(a, b) for a in range(hexes.shape[1]) for b in range(a + 1, hexes.shape[1])]
-    in_hexes = np.concatenate([hexes[:, [a, b]] for a, b in pairs])
-    X = model.mesh.p.T
-    lengths = np.linalg.norm(X[in_hexes[:, 1]] - X[in_hexes[:, 0]], axis=1)
-    return (np.concatenate([in_hexes, model.chordae.ends]),
-            np.concatenate([lengths, np.asarray(model.chordae.rest_length, dtype=float)]))
 
 
 def damping_weights(space) -> np.ndarray:

@@ -30,15 +30,17 @@ import numpy as np
 from ...io.abaqus import read_model, trivalve_input
 from ...valve.closure import (
     ClosureOptions,
-    EveryLoadFactor,
     closure_setup,
-    held_options,
-    relax_closure,
-    relaxation_options,
     write_log,
 )
 from ...valve.model import valve_model
 from ...valve.outputs import ClosureWriter, closure_measures
+from ...valve.relaxation import (
+    EveryLoadFactor,
+    held_stages,
+    relax_closure,
+    relaxation_options,
+)
 from ..table import Reason, Row, Stage, Written
 from .data import CREDIT, TABLE2_AREAS, TABLE3_CENTRE_STRESS
 from .figures import write_figures
@@ -86,7 +88,7 @@ def reproduce(out: Path | None = None, full: bool = False) -> Iterator[Row | Sta
     writer = None if out is None else ClosureWriter(Path(out) / "mathur2022_closure.pvd", setup)
     callbacks = [] if writer is None else [EveryLoadFactor(writer, 0.05)]
     controls = relaxation_options(options.pressure_start, rtol=options.rtol, atol=options.atol)
-    held = held_options(setup, rtol=options.rtol, atol=options.atol)  # the held load: energy trust region
+    held = held_stages(setup, rtol=options.rtol, atol=options.atol)  # the held load: energy trust region, staged
     run = relax_closure(setup, options.end, controls, callbacks=callbacks, progress=True, held=held)
     reached = run.load_factors[-1] if run.load_factors else 0.0
     if out is not None:
