@@ -115,6 +115,7 @@ TR_FLAGS = {
     "fit_radius": (int, "refactorisations with a raised shift for a step longer than the radius (0: scale it)"),
     "shift_scaling": (str, "D of the shift alpha D: diagonal (Marquardt) or uniform (Levenberg)"),
     "project_terms": (str, "comma-separated names of terms whose element blocks are projected (e.g. chordae)"),
+    "shift_terms": (str, "comma-separated names of terms whose indefinite blocks are shifted semidefinite (contact)"),
 }
 
 
@@ -207,8 +208,9 @@ def main() -> int:
             tr = {name: getattr(args, "tr_" + name) for name in TR_FLAGS if getattr(args, "tr_" + name) is not None}
             if "project" in tr:
                 tr["project"] = bool(tr["project"])
-            if "project_terms" in tr:
-                tr["project_terms"] = tuple(name for name in tr["project_terms"].split(",") if name)
+            for key in ("project_terms", "shift_terms"):
+                if key in tr:
+                    tr[key] = tuple(name for name in tr[key].split(",") if name)
             held = held_stages(setup, args.held_projected_steps, rtol=options.rtol, atol=options.atol, **tr)
             print(f"held load: {held}", flush=True)
         run = relax_closure(setup, options.end, ptc_options, callbacks=[LastState(args.out),

@@ -26,6 +26,7 @@ from skvalve.fem.trust_region import (
     trust_region,
     work_along,
 )
+from skvalve.fem.trust_steps import shift_psd
 from skvalve.materials import NeoHookean
 from skvalve.materials.uniaxial import OgdenUniaxial, TensionOnly
 
@@ -362,3 +363,36 @@ def test_a_stalled_stage_stops_where_its_energy_drop_falls_off_and_the_next_one_
     for bad in ({"stall_fraction": 1.0}, {"stall_fraction": -0.1}, {"stall_window": 1}):
         with pytest.raises(ValueError, match="stall"):
             TrustRegionOptions(**bad)
+
+
+def test_shifting_indefinite_blocks_adds_the_smallest_identity_that_makes_each_semidefinite():
+    """``shift_psd``: a block with eigenvalues (-2, 1, 3) in a rotated basis gains 2 I (eigenvalues 0, 3, 5), a
+    semidefinite one is unchanged; a sparse matrix of two such blocks on disjoint dofs gains each block's own shift.
+    On the pendulum block with its cable compressed, shifting the cable's blocks (``shifted``) adds -lambda_min of the
+    cable's element block on its six dofs alone, and the step matrix becomes semidefinite."""
+    rotation = np.linalg.qr(np.random.default_rng(3).standard_normal((3, 3)))[0]
+    indefinite = rotation @ np.diag([-2.0, 1.0, 3.0]) @ rotation.T
+    definite = rotation @ np.diag([0.5, 1.0, 3.0]) @ rotation.T
+    shifted = shift_psd(np.stack([indefinite, definite]))
+    np.testing.assert_allclose(np.linalg.eigvalsh(shifted[0]), [0.0, 3.0, 5.0], atol=1e-12)
+    np.testing.assert_allclose(shifted[1], definite, atol=1e-14)
+    lower = rotation @ np.diag([-0.5, 2.0, 4.0]) @ rotation.T
+    sparse = sp.block_diag([indefinite, lower, np.zeros((2, 2))], format="csr")
+    expected = sp.block_diag([indefinite + 2.0 * np.eye(3), lower + 0.5 * np.eye(3), np.zeros((2, 2))]).toarray()
+    np.testing.assert_allclose(project_sparse_psd(sparse, shift=True).toarray(), expected, atol=1e-12)
+    problem, centre, _ = _pendulum_block()
+    u = np.zeros(problem.space.n_dofs)
+    u[problem.space.displacement_dofs(np.array([0])).ravel()] = [0.0, 0.0, -0.1]  # cable stretch 0.8
+    _, tangent = problem.assemble(u, 1.0, tangent=True)
+    truss = next(term for term in problem.terms if isinstance(term, Truss))
+    block = next(b.matrices for b in tangent.contributions[problem.terms.index(truss)].blocks if b.matrices.size)[0]
+    lowest = np.linalg.eigvalsh(0.5 * (block + block.T))[0]
+    assert lowest < 0.0  # the compressed cable's lateral stiffness -N/l
+    plain = step_matrix(problem, tangent, False).toarray()
+    local = step_matrix(problem, tangent, False, shifted=(truss.name,)).toarray()
+    free = problem.pattern.free
+    cable = np.isin(free, problem.space.displacement_dofs(np.array([centre, 0])).ravel())
+    np.testing.assert_allclose(np.diag(local - plain)[cable], -lowest, rtol=1e-12)
+    off = local - plain - np.diag(np.diag(local - plain))
+    assert np.abs(off).max() <= 1e-12 * np.abs(plain).max() and np.abs(np.diag(local - plain)[~cable]).max() == 0.0
+    assert np.linalg.eigvalsh(plain).min() < 0.0 <= np.linalg.eigvalsh(local).min() + 1e-12

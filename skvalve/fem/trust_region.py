@@ -102,6 +102,11 @@ class TrustRegionOptions:
         tangent a negative lateral stiffness :math:`-N/\ell` per strut that an unprojected step matrix must
         out-shift, shortening every other mode's step with it, while the leaflets keep the soft curvature that
         projection would drop.
+    shift_terms : tuple of str
+        Names of terms whose indefinite element blocks (for a sparse matrix such as contact's: connected blocks) are
+        shifted by the smallest multiple of the identity that makes each semidefinite (:func:`shift_psd`): a local
+        Levenberg shift where one term's negative curvature (e.g. a contact pair near a free edge) would otherwise set
+        the global shift that damps every soft mode of the structure.
     eta : float
         Accept a step when :math:`\rho = \Delta\Pi/m \ge \eta`.
     local_shift, local_decay : float
@@ -152,6 +157,7 @@ class TrustRegionOptions:
     max_shift: float = 1e8
     project: bool = True
     project_terms: tuple[str, ...] = ()
+    shift_terms: tuple[str, ...] = ()
     eta: float = 0.01
     local_shift: float = 0.1
     local_decay: float = 0.5
@@ -357,8 +363,8 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                     record(step, work, math.nan, 0.0, largest, True, "newton try")
                     continue
             symmetric_K = (0.5 * (K + K.T)).tocsr()
-            H = step_matrix(problem, tangent, opts.project, opts.project_terms) \
-                if opts.project or opts.project_terms else symmetric_K
+            H = step_matrix(problem, tangent, opts.project, opts.project_terms, opts.shift_terms) \
+                if opts.project or opts.project_terms or opts.shift_terms else symmetric_K
             scale = np.abs(H.diagonal())
             typical = float(np.median(scale[scale > 0.0])) if np.any(scale > 0.0) else 1.0
             diagonal = np.maximum(scale, 1e-3 * typical)

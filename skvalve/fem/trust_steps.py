@@ -16,7 +16,8 @@ from scipy.sparse.csgraph import connected_components
 from . import linsolve
 from .problem import Problem, Tangent
 
-__all__ = ["project_psd", "project_sparse_psd", "step_matrix", "fitted_shift", "fit_radius", "shifted_direction",
+__all__ = ["project_psd", "shift_psd", "project_sparse_psd", "step_matrix", "fitted_shift", "fit_radius",
+           "shifted_direction",
            "factorize_counted", "largest_motion", "on_all_dofs", "FIT_ABOVE"]
 
 
@@ -30,10 +31,21 @@ def project_psd(matrices: np.ndarray) -> np.ndarray:
     return np.einsum("eik,ek,ejk->eij", vectors, np.maximum(values, 0.0), vectors, optimize=True)
 
 
-def project_sparse_psd(matrix: sp.spmatrix, largest: int = 4000) -> sp.csr_matrix:
+def shift_psd(matrices: np.ndarray) -> np.ndarray:
+    r"""Each (m, m) block's symmetric part :math:`B` plus :math:`\max(-\lambda_\min(B), 0)\,I`: the smallest
+    uniform diagonal that makes it positive semidefinite (a Levenberg shift of that block alone). Unlike
+    :func:`project_psd` it stiffens every direction of an indefinite block, so a step does not run along the
+    curvature it drops."""
+    symmetric = 0.5 * (matrices + np.swapaxes(matrices, -1, -2))
+    lowest = np.linalg.eigvalsh(symmetric)[..., 0]
+    return symmetric + np.maximum(-lowest, 0.0)[..., None, None] * np.eye(symmetric.shape[-1])
+
+
+def project_sparse_psd(matrix: sp.spmatrix, largest: int = 4000, shift: bool = False) -> sp.csr_matrix:
     """The symmetric part of a sparse matrix with each connected block (the components of its pattern's graph, e.g.
-    one patch of contact pairs) projected onto its positive semidefinite part; a block of more than ``largest`` rows
-    keeps its symmetric part (a dense eigendecomposition would cost too much)."""
+    one patch of contact pairs) projected onto its positive semidefinite part (``shift``: shifted to it,
+    :func:`shift_psd`); a block of more than ``largest`` rows keeps its symmetric part (a dense eigendecomposition
+    would cost too much)."""
     symmetric = (0.5 * (matrix + matrix.T)).tocsr()
     symmetric.eliminate_zeros()
     rows = np.flatnonzero(np.diff(symmetric.indptr))
@@ -48,9 +60,7 @@ def project_sparse_psd(matrix: sp.spmatrix, largest: int = 4000) -> sp.csr_matri
         local = order[bounds[k]: bounds[k + 1]]
         block = inner[local][:, local].toarray()
         if local.size <= largest:
-            values, vectors = np.linalg.eigh(block)
-            if values.min() < 0.0:
-                block = (vectors * np.maximum(values, 0.0)) @ vectors.T
+            block = shift_psd(block) if shift else project_psd(block)
         r, c = np.meshgrid(rows[local], rows[local], indexing="ij")
         out_rows.append(r.ravel())
         out_cols.append(c.ravel())
@@ -59,21 +69,31 @@ def project_sparse_psd(matrix: sp.spmatrix, largest: int = 4000) -> sp.csr_matri
                          shape=matrix.shape)
 
 
-def step_matrix(problem: Problem, tangent: Tangent, project: bool, terms: tuple[str, ...] = ()) -> sp.csr_matrix:
+def step_matrix(problem: Problem, tangent: Tangent, project: bool, terms: tuple[str, ...] = (),
+                shifted: tuple[str, ...] = ()) -> sp.csr_matrix:
     """The symmetric part of the free-dof tangent; when ``project``, with the element blocks of every symmetric term
     and the extra sparse matrices (e.g. contact: :func:`project_sparse_psd`) projected onto their positive
     semidefinite parts (a non-symmetric term's blocks, e.g. a follower pressure's load stiffness, enter with their
     symmetric parts: their negative curvature is the structure's response to the load, which the shift handles);
-    else only the blocks and matrices of the terms named in ``terms``."""
+    else only the blocks and matrices of the terms named in ``terms``; those of the terms named in ``shifted`` are
+    shifted to semidefinite ones (:func:`shift_psd`)."""
+
+    def chosen(term) -> str | None:
+        name = getattr(term, "name", None)
+        if name in shifted:
+            return "shift"
+        return "project" if project or name in terms else None
 
     def blocks(term, matrices):
-        if (project or getattr(term, "name", None) in terms) and getattr(term, "symmetric", True):
-            return project_psd(matrices)
+        how = chosen(term) if getattr(term, "symmetric", True) else None
+        if how is not None:
+            return shift_psd(matrices) if how == "shift" else project_psd(matrices)
         return 0.5 * (matrices + np.swapaxes(matrices, -1, -2))
 
     def matrix(term, sparse):
-        if project or getattr(term, "name", None) in terms:
-            return project_sparse_psd(sparse)
+        how = chosen(term)
+        if how is not None:
+            return project_sparse_psd(sparse, shift=how == "shift")
         return 0.5 * (sparse + sparse.T)
 
     return problem.tangent_matrix(tangent, blocks=blocks, matrix=matrix).tocsr()
