@@ -163,6 +163,7 @@ def test_reproduce_full_writes_the_figures_of_the_last_state(setup, tmp_path, mo
     def stopped(setup, end, options, callbacks=(), progress=True, held=None):
         first, last = held  # held: the trust region's stages, projected steps first
         assert first.project and first.stall_fraction > 0.0 and not last.project
+        assert first.shift_terms == () and last.shift_terms == ("contact",)  # the contact shifted locally at the end
         assert first.radius == last.radius == 0.25 * setup.contact.max_penetration
         assert last.newton_below > 0.0
         return ClosureRun(load_factors=[0.0], iterations=[0], contact_pairs=[0],
