@@ -14,12 +14,14 @@ from skvalve.fem.amplitudes import SmoothStep
 from skvalve.fem.constitutive import MaterialRegions
 from skvalve.fem.contact import ContactSurface, SurfaceContact
 from skvalve.fem.damping import DampingSchedule, ViscousDamping
+from skvalve.fem.errors import ConvergenceError
 from skvalve.fem.hyperelastic import HyperelasticTerm
 from skvalve.fem.ptc import PseudoTransientOptions
-from skvalve.fem.trust_region import TrustRegionOptions, TrustRegionStep
+from skvalve.fem.trust_region import TrustRegionOptions, TrustRegionResult, TrustRegionStep
 from skvalve.io.abaqus import read_model, trivalve_input
 from skvalve.materials import NeoHookean
 from skvalve.papers.mathur2022 import reproduce as reproduce_module
+from skvalve.valve import relaxation as relaxation_module
 from skvalve.valve.closure import (
     ClosureOptions,
     ClosureSetup,
@@ -128,6 +130,37 @@ def test_held_stages_hand_on_their_state_and_end_where_one_stage_does():
                             held=[stages[0], replace(stages[1], max_steps=1)])
     assert failing.error is not None and "1 steps without converging" in failing.error
 
+
+
+def test_a_held_relaxation_that_fails_before_its_first_step_reports_the_error_and_keeps_the_start(monkeypatch):
+    """Resumed at the held load, a trust region that raises at once (a bug, or giving up with no step taken) is
+    recorded as the run's error with the load factor of the start, and with the state it was handed as the kept state
+    when the error carries it: no IndexError from an empty history."""
+    ptc = PseudoTransientOptions(damping=0.5, first_step=0.05, max_load_step=0.25, rtol=1e-9, solver="scipy")
+    setup = _blocks_setup(0.15, damped=False, blend=0.1)
+    u0 = np.zeros(setup.problem.space.n_dofs)
+
+    def broken(problem, t, u, options, **kwargs):
+        raise ValueError("einsum failed")
+
+    monkeypatch.setattr(relaxation_module, "trust_region", broken)
+    run = relax_closure(setup, 1.5, ptc, progress=False, u0=u0, t0=1.5, held=TrustRegionOptions(solver="scipy"))
+    assert run.error == "ValueError: einsum failed" and run.load_factors == [1.5] and run.u is None
+
+    handed = []
+
+    def giving_up(problem, t, u, options, **kwargs):
+        handed.append(u.copy())  # the start: u0 with the held load's prescribed values
+        error = ConvergenceError("no shift gives a positive definite step matrix")
+        error.last_state = TrustRegionResult(u=u, load_factor=t)
+        raise error
+
+    monkeypatch.setattr(relaxation_module, "trust_region", giving_up)
+    run = relax_closure(_blocks_setup(0.15, damped=False, blend=0.1), 1.5, ptc, progress=False, u0=u0, t0=1.5,
+                        held=TrustRegionOptions(solver="scipy"))
+    assert run.error.startswith("ConvergenceError") and run.load_factors == [1.5]
+    np.testing.assert_array_equal(run.u, handed[0])
+    assert run.undamped_residual[1] > 0.0  # the blocks pressed 0.15 into each other are not in equilibrium
 
 def test_contact_pairs_closer_than_exclude_within_in_the_reference_are_never_active():
     """The two faces at z = 1 coincide in the reference: pressed 0.1 into each other, every node pairs (9 per face,

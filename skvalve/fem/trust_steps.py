@@ -60,7 +60,7 @@ def project_sparse_psd(matrix: sp.spmatrix, largest: int = 4000, shift: bool = F
         local = order[bounds[k]: bounds[k + 1]]
         block = inner[local][:, local].toarray()
         if local.size <= largest:
-            block = shift_psd(block) if shift else project_psd(block)
+            block = (shift_psd if shift else project_psd)(block[None])[0]
         r, c = np.meshgrid(rows[local], rows[local], indexing="ij")
         out_rows.append(r.ravel())
         out_cols.append(c.ravel())

@@ -110,7 +110,7 @@ def relax_closure(setup: ClosureSetup, end: float,
     weights = damping_weights(setup.problem.space)
     clearance = partial(clearance_fraction, setup.contact)
     start = time.perf_counter()
-    result = None
+    result, first_load = None, float(t0)
 
     def add_effort(stage_result) -> None:
         counts = [("rejected_steps", stage_result.rejected)]
@@ -166,6 +166,8 @@ def relax_closure(setup: ClosureSetup, end: float,
         run.seconds = time.perf_counter() - start
     if result is not None and run.error is None and not result.converged:
         run.error = "did not converge"
+    if not run.load_factors:  # failed before its first step: the load factor of the kept (or starting) state
+        run.load_factors.append(float(getattr(result, "load_factor", first_load)))
     if run.u is not None:
         run.undamped_residual = undamped_residual(setup.problem, run.u, run.load_factors[-1])
     return run
