@@ -479,6 +479,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
         bar.close()
     return result
 
+
 def _stalled(energy_changes: list[float], opts: TrustRegionOptions) -> bool:
     """Whether the energy drop of the last ``stall_window`` steps averages below ``stall_fraction`` of its average
     over all steps (:class:`TrustRegionOptions`)."""

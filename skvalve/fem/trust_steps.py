@@ -17,8 +17,7 @@ from . import linsolve
 from .problem import Problem, Tangent
 
 __all__ = ["project_psd", "shift_psd", "project_sparse_psd", "step_matrix", "fitted_shift", "fit_radius",
-           "shifted_direction",
-           "factorize_counted", "largest_motion", "on_all_dofs", "FIT_ABOVE"]
+           "shifted_direction", "factorize_counted", "largest_motion", "on_all_dofs", "FIT_ABOVE"]
 
 
 def project_psd(matrices: np.ndarray) -> np.ndarray:

@@ -181,7 +181,7 @@ HELD_NEWTON_BELOW = 1e-4
 #: largest nodal motion (mm) of one held step; what keeps nodes from passing through a sheet is the clearance limit
 HELD_MAX_RADIUS = 1.0
 
-#: whether the held valve's step matrix projects the element blocks onto positive semidefinite ones: not, since from the
+#: whether the held valve's last stage projects the element blocks onto positive semidefinite ones: not, since from the
 #: same held 1.0 diseased state (relative residual 1.8e-3) the plain symmetric tangent with the inertia-corrected shift
 #: reached 3.0e-4 in 152 steps, the projected one no lower than 7.6e-3 in 39; from the pressure stage's end (2.1e-3)
 #: 1.7e-3 in 194 steps with 8 rejected, the projected one none below its first step in 196 (138 rejected in its run)
