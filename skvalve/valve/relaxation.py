@@ -200,8 +200,8 @@ HELD_SHIFT_SCALING = "uniform"
 #: (:attr:`~skvalve.fem.trust_region.TrustRegionOptions.shift_terms`): at the 1.0 diseased valve's state after the
 #: projected and the unprojected stage (relative residual 6.0e-4) the lowest eigenvalue of the symmetric tangent,
 #: -0.175 N/mm, is one contact pair's, and it set a global shift that damps the soft modes a thousandfold; with the
-#: contact shifted locally, 205 further steps from there went 2.77 N·mm down to a best of 2.9e-4, the coaptation area
-#: from 172 to 254 mm² (the unprojected stage's own last 40 steps before that state: 0.12 N·mm, no lower residual)
+#: contact shifted locally, 254 further steps from there went 2.97 N·mm down to a best of 1.25e-4, the coaptation area
+#: from 172 to 261 mm² (the unprojected stage's own last 40 steps before that state: 0.12 N·mm, no lower residual)
 HELD_SHIFT_TERMS = ("contact",)
 
 
