@@ -58,6 +58,7 @@ OPTION_FLAGS = {
     "contact_exclude_within": (float, "node-face pairs closer than this (mm) in the reference never contact"),
     "contact_blend": (float, "blended contact band beta (0: closest triangle)"),
     "contact_barrier": (float, "overlap (fraction of the search depth) from which the depth barrier acts; -1: none"),
+    "contact_depth": (float, "contact search depth (mm): deeper passes are ignored (default: bricks' mean face edge)"),
     "contact_ramp": (float, "step-time interval over which the contact penalty rises smoothly to its value"),
     "penalty": (float, "contact penalty (MPa/mm)"),
     "cable_compression": (int, "1: cables that are one input truss carry their law in compression too"),

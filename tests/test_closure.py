@@ -26,6 +26,7 @@ from skvalve.valve.closure import (
     ClosureOptions,
     ClosureSetup,
     _PenaltyFrom,
+    closure_setup,
     contact_surface,
     load_factors,
     run_closure,
@@ -251,6 +252,18 @@ def test_contact_surface_of_the_shipped_valve_lies_on_the_boundary_and_faces_out
     assert abaqus.amplitude("Amp-2").times[-1] == pytest.approx(0.5)
     assert abaqus.amplitude("Amp-1").times[-1] == pytest.approx(1.5)
     assert load_factors(ClosureOptions())[-1] == pytest.approx(abaqus.steps[0].time_period)
+    # the search depth: bricks default to the mean edge of the surface's faces; contact_depth sets it
+    edges = np.linalg.norm(Q - np.roll(Q, 1, axis=1), axis=2)
+    default = closure_setup(options=ClosureOptions(), abaqus=abaqus, model=model).contact
+    assert default.max_penetration == pytest.approx(edges.mean(), rel=1e-12)
+    shallow = closure_setup(options=ClosureOptions(contact_depth=0.2), abaqus=abaqus, model=model).contact
+    assert shallow.max_penetration == 0.2
+
+
+@pytest.mark.parametrize("depth", [0.0, -0.1, float("nan"), float("inf"), "0.2"])
+def test_a_contact_depth_that_is_not_a_positive_length_is_refused(depth):
+    with pytest.raises(ValueError, match="contact_depth"):
+        ClosureOptions(contact_depth=depth)
 
 
 def test_reproduce_without_the_shipped_input_exits_with_a_message(monkeypatch, capsys):

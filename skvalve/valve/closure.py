@@ -20,6 +20,7 @@ valve runs take, relaxation without Newton's load steps, is :mod:`.relaxation`.
 
 from __future__ import annotations
 
+import math
 import resource
 import time
 from dataclasses import dataclass, field
@@ -76,6 +77,9 @@ class ClosureOptions:
     contact_barrier : ``None`` for the penalty alone; else the overlap (a fraction of the search depth) from which a log
     barrier adds pressure that grows without bound towards the clearance limit's floor
     (:class:`~skvalve.fem.contact.SurfaceContact` ``barrier``, :mod:`~skvalve.fem.contact_laws`).
+    contact_depth : the contact's search depth g_max (mm; ``SurfaceContact`` ``max_penetration``): deeper
+    passes are ignored and the clearance limit keeps steps to three quarters of it. ``None``: a quarter of the
+    thinnest stack on extruded shells (their two skins a thickness apart must not pair), the mean face edge on bricks.
     contact_ramp : the penalty rises from zero at ``contact_from`` to ``penalty`` over this step-time interval (a smooth
     step): folds that overlap when it switches on are pushed apart gradually (switched on at once, three overlapping
     pairs at the free edge of the 1.0 valve threw their nodes by millimetres and stalled the pseudo-time steps at
@@ -120,9 +124,15 @@ class ClosureOptions:
     contact_exclude_within: float = 0.0
     contact_blend: float = 0.0
     contact_barrier: float | None = None
+    contact_depth: float | None = None
     cable_slack_fraction: float = 1e-6
     cable_compression: bool = False
     pressure_damping: float = 1e-4
+
+    def __post_init__(self) -> None:
+        depth = self.contact_depth
+        if depth is not None and not (isinstance(depth, (int, float)) and math.isfinite(depth) and depth > 0.0):
+            raise ValueError(f"ClosureOptions.contact_depth must be a positive length (mm) or None; got {depth!r}")
 
     @classmethod
     def for_relaxation(cls, model: ValveModel, **overrides) -> ClosureOptions:
@@ -225,6 +235,8 @@ def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: Abaq
     # quarter of the thinnest stack keeps them from pairing (bricks: the contact term's default depth)
     thinnest = thinnest_stack(model, abaqus)
     depth = None if thinnest is None else 0.25 * thinnest
+    if options.contact_depth is not None:
+        depth = float(options.contact_depth)
     penalty = options.penalty if options.contact_from <= 0.0 and options.contact_ramp <= 0.0 else \
         _PenaltyFrom(options.penalty, options.contact_from, options.contact_ramp)
     contact = problem.add_term(SurfaceContact(problem.space, surface, penalty, max_penetration=depth,
