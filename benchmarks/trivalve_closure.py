@@ -21,9 +21,13 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+import scipy.sparse as sp
 
+from skvalve.fem import linsolve
 from skvalve.fem.damping import undamped_residual
 from skvalve.fem.soft_modes import soft_modes
+from skvalve.fem.taylor import taylor_test
+from skvalve.fem.trust_steps import step_matrix
 from skvalve.io.abaqus import read_model, trivalve_input
 from skvalve.io.files import replace_atomically
 from skvalve.papers.mathur2022.figures import write_figures
@@ -137,6 +141,9 @@ def main() -> int:
                         help="with --resume: measure and draw the kept state (Table 2-3 rows, figures, VTU), no solve")
     parser.add_argument("--soft-modes", type=int, default=0, metavar="K",
                         help="also print the K softest modes of the symmetric tangent at the end (fem.soft_modes)")
+    parser.add_argument("--taylor", action="store_true",
+                        help="also print each term's linearisation remainder along the held stage's step at the end "
+                             "(fem.taylor_test)")
     parser.add_argument("--held-projected-steps", type=int, default=HELD_PROJECTED_STEPS, metavar="N",
                         help="the held load's first stage: at most N projected steps, until its energy drop stalls "
                              "(0: none; --tr-* flags set the last stage) (default: %(default)s)")
@@ -254,6 +261,8 @@ def main() -> int:
               f"{corners.shape[0]}; smallest corner Jacobian {corners.min():.3g} (det dx/dxi)")
         if args.soft_modes > 0:
             _print_soft_modes(setup, run.u, t, args.soft_modes)
+        if args.taylor:
+            _print_taylor(setup, run.u, t)
         ClosureWriter(args.out / "final_state.pvd", setup).write(t, run.u)
         credit = "Texas TriValve " + ("1.1" if "1.1" in str(path) else "1.0") + " (Mathur et al. 2022), " + \
                  ("CC BY 4.0" if "1.1" in str(path) else "CC BY-NC-SA 4.0")
@@ -278,6 +287,27 @@ def _print_soft_modes(setup, u: np.ndarray, t: float, count: int) -> None:
         nodes = modes.moving_nodes(j, problem.space.dim, n_nodes, count=5)
         print(f"  mode {j}: {value:.3e}  {along:+.3e}  {reach:+.3g}  nodes "
               + ", ".join(f"{node} ({region[node]})" for node in nodes))
+
+
+def _print_taylor(setup, u: np.ndarray, t: float, shift: float = 0.01) -> None:
+    """Each term's linearisation remainder (fem.taylor_test) along the held stage's step at ``u``: the symmetric
+    tangent with the contact's indefinite blocks shifted, plus ``shift`` times its median diagonal, solved for -R."""
+    problem = setup.problem
+    free = problem.pattern.free
+    residual, tangent = problem.assemble(u, t)
+    matrix = step_matrix(problem, tangent, project=False, shifted=("contact",))
+    diagonal = np.abs(matrix.diagonal())
+    matrix = matrix + shift * float(np.median(diagonal[diagonal > 0])) * sp.identity(matrix.shape[0], format="csr")
+    direction = np.zeros(problem.space.n_dofs)
+    direction[free] = linsolve.solve(matrix.tocsr(), -residual[free], symmetric=True)
+    region = np.full(problem.space.n_scalar, -1)
+    region[: setup.leaflet_of_vertex.size] = setup.leaflet_of_vertex
+    print(f"linearisation remainders along the held step (|R_f| {np.linalg.norm(residual[free]):.3e} N; step length = "
+          "largest nodal motion, mm; the nodes with the largest remainder and their region):")
+    for term in taylor_test(problem, u, t, direction, lengths=(0.003, 0.01, 0.03, 0.1)):
+        cells = ", ".join(f"{h:g}: {e:.2e}" for h, e in zip(term.lengths, term.errors, strict=True))
+        print(f"  {term.name:18s} {cells}; orders {np.round(term.orders, 2).tolist()}; at 0.01 mm nodes "
+              + ", ".join(f"{node} ({region[node]})" for node in term.worst_nodes[1]))
 
 
 if __name__ == "__main__":

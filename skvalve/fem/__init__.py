@@ -32,11 +32,12 @@ from .result import Result
 from .soft_modes import SoftModes, soft_modes
 from .solid import Solid
 from .space import Space
+from .taylor import TermTaylor, taylor_test
 from .terms import Blocks, Contribution, Term
 
 __all__ = [
     "Solid", "Problem", "Term", "Blocks", "Contribution", "HyperelasticTerm", "MaterialRegions", "FollowerPressure",
     "NodalForce", "Result", "Space", "solve", "StepEvent", "SolverError", "ConvergenceError",
     "NonPositiveJacobianError", "SingularSystemError", "OutputError", "TangledMeshError", "SolverUnavailableError",
-    "solver_name", "available_solvers", "SoftModes", "soft_modes",
+    "solver_name", "available_solvers", "SoftModes", "soft_modes", "TermTaylor", "taylor_test",
 ]
