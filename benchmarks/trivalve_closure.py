@@ -96,6 +96,7 @@ PTC_FLAGS = {
     "damping": (float, "damping coefficient c of the pseudo-time flow (N s/mm^4)"),
     "max_load_step": (float, "largest pseudo-time step while the load moves"),
     "max_increment": (float, "trust region: largest nodal displacement change per step (mm)"),
+    "fill": (float, "grow the pseudo-time step only to fill this share of the trust regions (0: off)"),
     "first_step": (float, "first pseudo-time step"),
     "max_steps": (int, "the most accepted pseudo-steps"),
     "stiffness_damping": (float, "stiffness-proportional damping beta |diag K| / dtau"),
@@ -207,6 +208,8 @@ def main() -> int:
         run.undamped_residual = undamped_residual(setup.problem, u0, t0)
     elif args.method == "ptc":
         ptc = {name: getattr(args, "ptc_" + name) for name in PTC_FLAGS if getattr(args, "ptc_" + name) is not None}
+        if ptc.get("fill") == 0.0:
+            ptc["fill"] = None
         ptc_options = relaxation_options(options.pressure_start, rtol=options.rtol, atol=options.atol, **ptc)
         if ptc:  # flags set every stage's controls
             ptc_options = [(until, replace(stage, **ptc)) for until, stage in ptc_options]
@@ -295,6 +298,7 @@ def _print_taylor(setup, u: np.ndarray, t: float, shift: float = 0.01) -> None:
     problem = setup.problem
     free = problem.pattern.free
     residual, tangent = problem.assemble(u, t)
+    problem.commit()  # the state a held step starts from (the contact's facing factors are taken there)
     matrix = step_matrix(problem, tangent, project=False, shifted=("contact",))
     diagonal = np.abs(matrix.diagonal())
     matrix = matrix + shift * float(np.median(diagonal[diagonal > 0])) * sp.identity(matrix.shape[0], format="csr")

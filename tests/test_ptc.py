@@ -210,6 +210,28 @@ def test_slack_exponential_chord_against_the_closed_form_with_the_strain_trust_r
     assert 0.1 * force / (0.33 * k_slack / 2.2) > 1e3
 
 
+def test_filling_the_trust_region_ends_where_newton_does_with_fewer_rejected_steps():
+    """The sheared block followed under a nodal trust region that binds (the prescribed face moves 0.5 at most
+    0.02 a step): growing the step by load_growth alone keeps breaking the region (each rejection a wasted
+    factorisation); aiming each next step at 0.8 of the region from the last one's use (fill) rejects fewer, holds
+    the region on every accepted step and ends where load-stepped Newton does."""
+    newton = solve(sheared_block(), 10, progress=False, rtol=1e-11)
+    runs = {}
+    for fill in (None, 0.8):
+        block = sheared_block()
+        moves = []
+        options = PseudoTransientOptions(damping=1.0, first_step=0.01, max_load_step=1.0, rtol=1e-11,
+                                         max_increment=0.02, max_strain_increment=None, fill=fill)
+        runs[fill] = pseudo_transient(block, lumped_volume(block.space), 1.0, options, progress=False,
+                                      callbacks=[lambda event, seen=moves: seen.append(event.u.copy())])
+        assert runs[fill].converged
+        assert np.abs(runs[fill].u - newton.u()).max() <= 1e-9 * np.abs(newton.u()).max()
+        assert max(runs[fill].largest_increments) <= 0.02
+    assert runs[None].rejected >= 5 and runs[0.8].rejected <= runs[None].rejected // 3
+    with pytest.raises(ValueError, match="fill"):
+        PseudoTransientOptions(fill=1.5)
+
+
 class _JumpForce(Term):
     """A dead force ``jump`` on one dof once it passes ``at`` (zero tangent): a discontinuity like a contact pair that
     switches on at a finite overlap."""

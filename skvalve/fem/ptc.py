@@ -181,7 +181,7 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
                 beta = opts.stiffness_damping(t_new) if callable(opts.stiffness_damping) else opts.stiffness_damping
             try:
                 local = np.where(boost > 1.0, floor, weights)
-                trial, trial_residual, trial_tangent, largest = _step(problem, u, t, t_new, dtau, tangent, local,
+                trial, trial_residual, trial_tangent, largest, used = _step(problem, u, t, t_new, dtau, tangent, local,
                                                                        boost, norm, opts, solver, step,
                                                                        result.timings, edges, float(beta), limit)
             except _Rejected as err:
@@ -225,11 +225,14 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
             event = PseudoTransientStep(problem, step, tau, t, u, norm, relative)
             for callback in callbacks:
                 callback(event)
+            dtau_taken = dtau
             if t < end:  # following the load: grow back towards the load path's resolution after cuts
                 dtau = min(dtau * opts.load_growth, opts.max_load_step)
             else:  # switched evolution relaxation
                 dtau *= min(opts.growth, max(previous / max(norm, 1e-300), opts.held_growth if norm <= previous
                                              else 0.5))
+            if opts.fill is not None and used > 0.0:  # aim the next step at a share of the trust regions
+                dtau = min(dtau, dtau_taken * opts.fill / used)
             failure = None
         else:
             raise _give_up(problem, None, None, len(result.pseudo_times), t, result, dtau, best,
@@ -242,7 +245,8 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
 def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent, weights, boost, norm: float,
           opts: PseudoTransientOptions, solver: str, step: int, timings: dict, edges: tuple | None, beta: float,
           limit=None):
-    """One linearised implicit-Euler step with the damping diagonal ``boost * (c weights + beta |diag K|)``;
+    """One linearised implicit-Euler step with the damping diagonal ``boost * (c weights + beta |diag K|)``: the
+    trial state, its residual and tangent, the largest nodal move and the largest share of a trust region used;
     raises :class:`_Rejected` (with a cut ``factor`` and the ``nodes`` to damp) when it fails a test."""
     pattern = problem.pattern
     fixed, free = pattern.fixed, pattern.free
@@ -279,6 +283,7 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
     space = problem.space
     moves = np.linalg.norm(du[: space.n_u].reshape(-1, space.dim), axis=1)
     largest = float(np.max(moves, initial=0.0))
+    used = largest / opts.max_increment if opts.max_increment is not None else 0.0
     if opts.max_increment is not None and largest > opts.max_increment:
         raise _Rejected(f"a node would move {largest:.3g} > max_increment {opts.max_increment:g}",
                         max(0.1, 0.7 * opts.max_increment / largest), np.flatnonzero(moves > opts.max_increment))
@@ -291,6 +296,7 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
         changes = _stretch_changes(edges[2], u, trial, edges[0], edges[1])
         worst = int(np.argmax(changes))
         change = float(changes[worst])
+        used = max(used, change / opts.max_strain_increment)
         if change > opts.max_strain_increment:
             a, b = edges[0][worst]
             raise _Rejected(f"the stretch of edge {a}-{b} would change by {change:.3g} > max_strain_increment "
@@ -310,7 +316,7 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
     if trial_norm > opts.blow_up * reference and dtau >= opts.accept_jumps_below:
         carriers = _carriers(trial_residual, free, space)
         raise _Rejected(f"|R| grows from {reference:.3e} to {trial_norm:.3e}", nodes=carriers)
-    return trial, trial_residual, trial_tangent, largest
+    return trial, trial_residual, trial_tangent, largest, used
 
 
 def _limited(limit, u: np.ndarray, p: np.ndarray, solver: str) -> float:

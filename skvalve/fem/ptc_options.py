@@ -43,6 +43,12 @@ class PseudoTransientOptions:
     load_growth : float
         The growth of :math:`\Delta\tau` per accepted step while the load moves (back towards ``max_load_step``
         after a cut; a gentle value wastes fewer rejected steps on a path whose trust regions bind).
+    fill : float or None
+        Grow :math:`\Delta\tau` no further than to fill this fraction of the trust regions (``max_increment``,
+        ``max_strain_increment``), predicted from the share of them the last accepted step used (a step that
+        follows the load or a damped flow is about proportional to :math:`\Delta\tau`): the next
+        :math:`\Delta\tau` is at most :math:`\Delta\tau\,\text{fill}/\text{used}`, so a path whose trust
+        regions bind stops proposing steps that break them (each rejection costs a factorisation). ``None``: off.
     max_increment : float or None
         Trust region: the largest nodal displacement change in one step (length); ``None``: off.
     max_strain_increment : float or None
@@ -85,6 +91,7 @@ class PseudoTransientOptions:
     growth: float = 2.0
     held_growth: float = 1.0
     load_growth: float = 1.25
+    fill: float | None = None
     max_increment: float | None = 0.5
     max_strain_increment: float | None = 0.05
     blow_up: float = 10.0
@@ -124,6 +131,8 @@ class PseudoTransientOptions:
                                                             and self.held_stiffness_damping >= 0):
             raise ValueError("PseudoTransientOptions.held_stiffness_damping must be None or finite and >= 0; "
                              f"got {self.held_stiffness_damping!r}")
+        if self.fill is not None and not (isinstance(self.fill, int | float) and 0.0 < self.fill <= 1.0):
+            raise ValueError(f"PseudoTransientOptions.fill must be None or lie in (0, 1]; got {self.fill!r}")
         if not (math.isfinite(self.atol) and self.atol >= 0):
             raise ValueError(f"PseudoTransientOptions.atol must be finite and >= 0; got {self.atol!r}")
         if not 0.0 < self.local_decay <= 1.0:

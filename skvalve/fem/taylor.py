@@ -62,7 +62,9 @@ def taylor_test(problem: Problem, u: np.ndarray, t: float, direction: np.ndarray
                 lengths: Sequence[float] = (1e-3, 3e-3, 1e-2, 3e-2, 1e-1), n_worst: int = 4) -> list[TermTaylor]:
     """Remainders of every term's linearisation at ``u`` (load factor ``t``) along ``direction`` (all dofs), scaled so
     that its largest nodal motion is each of ``lengths`` (module docstring). The terms are assembled at the trial
-    states but nothing is committed; a trial state a term refuses (e.g. an inverted element) raises its error."""
+    states but nothing is committed (a term whose energy lags a committed state, such as blended contact's facing
+    factors, is tested on the energy of its last commit: commit at ``u`` first to test the one a solver step from ``u``
+    sees); a trial state a term refuses (e.g. an inverted element) raises its error."""
     u, direction = np.asarray(u, dtype=float), np.asarray(direction, dtype=float)
     n = problem.space.n_dofs
     if u.shape != (n,) or direction.shape != (n,):
