@@ -181,9 +181,9 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
                 beta = opts.stiffness_damping(t_new) if callable(opts.stiffness_damping) else opts.stiffness_damping
             try:
                 local = np.where(boost > 1.0, floor, weights)
-                trial, trial_residual, trial_tangent, largest, used = _step(problem, u, t, t_new, dtau, tangent, local,
-                                                                       boost, norm, opts, solver, step,
-                                                                       result.timings, edges, float(beta), limit)
+                trial, trial_residual, trial_tangent, largest, used = _step(
+                    problem, u, t, t_new, dtau, tangent, local, boost, norm, opts, solver, step, result.timings, edges,
+                    float(beta), limit)
             except _Rejected as err:
                 problem.rewind()
                 result.rejected += 1
