@@ -194,6 +194,7 @@ def test_relaxation_controls_and_sampled_output():
     assert first.local_damping == 1.0 and first.rtol == 1e-3
     assert last_until == np.inf and last.rtol == 1e-7 and last.stiffness_damping == 1e-3 and last.local_damping == 10
     assert last.held_stiffness_damping == 0.0  # none once the pressure is held
+    assert first.fill == last.fill == 0.8  # both grow the step only to 0.8 of the trust regions
     assert len(relaxation_options(0.0)) == 1  # everything ramps together: one stage
     seen = []
     sampler = EveryLoadFactor(lambda event: seen.append(event.load_factor), 0.05)

@@ -32,7 +32,10 @@ __all__ = ["EveryLoadFactor", "HELD_PROJECTED_STEPS", "HELD_STALL_FRACTION", "he
 def relaxation_options(pressure_start: float = 0.5, **overrides) -> list[tuple[float, PseudoTransientOptions]]:
     """Pseudo-transient stages for the Texas TriValve closure (units mm, MPa, step time), found on the 1.0 diseased
     valve, as ``(until, options)`` for :func:`relax_closure`. Both: damping 1e-5 per lumped volume, load steps of at
-    most 0.005 (the tips move up to 0.25 mm per step), 0.5 mm trust region on any node.
+    most 0.005 (the tips move up to 0.25 mm per step), 0.5 mm trust region on any node, and Δτ grown only to fill 0.8
+    of the trust regions from the last step's use (``fill``: on the 1.0 diseased valve the papillary stage took 690
+    attempts, 87 rejected, against 809 and 213 without, 55 against 61 min, and arrived at the held load within a median
+    0.0017 mm and the same residual, 2.83e-3).
 
     * up to ``pressure_start`` (the papillary tips move): a trust region of 0.05 on any edge's or cable's tensile
       stretch per step, nothing else (larger regions let the hexes next to the insertions reach states that lose
@@ -47,7 +50,7 @@ def relaxation_options(pressure_start: float = 0.5, **overrides) -> list[tuple[f
 
     The first stage ends on a loose relative residual (1e-3): its end state only starts the second.
     """
-    common = {"damping": 1e-5, "max_load_step": 0.005, "first_step": 5e-4, "max_increment": 0.5}
+    common = {"damping": 1e-5, "max_load_step": 0.005, "first_step": 5e-4, "max_increment": 0.5, "fill": 0.8}
     stages = []
     if pressure_start > 0.0:
         stages.append((pressure_start, PseudoTransientOptions(**common, max_strain_increment=0.05, rtol=1e-3)))
