@@ -83,10 +83,7 @@ class BlockRelaxation:
         rows, cols, values = [], [], []
         for term in self.terms:
             contribution = term.assemble(u, t, tangent, None)
-            if contribution.internal is not None:
-                force += contribution.internal
-            if contribution.external is not None:
-                force -= contribution.external
+            force += contribution.residual(n)
             if tangent:
                 for block in contribution.blocks:
                     local = self._local[block.dofs]

@@ -48,16 +48,6 @@ class TermTaylor:
     worst_nodes: np.ndarray
 
 
-def _term_force(contribution, free: np.ndarray, n: int) -> np.ndarray:
-    """A term's residual (internal - external) on the free dofs."""
-    force = np.zeros(n)
-    if contribution.internal is not None:
-        force += contribution.internal
-    if contribution.external is not None:
-        force -= contribution.external
-    return force[free]
-
-
 def taylor_test(problem: Problem, u: np.ndarray, t: float, direction: np.ndarray,
                 lengths: Sequence[float] = (1e-3, 3e-3, 1e-2, 3e-2, 1e-1), n_worst: int = 4) -> list[TermTaylor]:
     """Remainders of every term's linearisation at ``u`` (load factor ``t``) along ``direction`` (all dofs), scaled so
@@ -80,14 +70,13 @@ def taylor_test(problem: Problem, u: np.ndarray, t: float, direction: np.ndarray
     unit = direction / largest
     base = [term.assemble(u, t, True, None) for term in problem.terms]
     slopes = [problem.apply(Tangent([contribution]), unit)[free] for contribution in base]
-    forces = [_term_force(contribution, free, n) for contribution in base]
+    forces = [contribution.residual(n)[free] for contribution in base]
     errors = np.zeros((len(problem.terms), lengths.size))
     worst = np.zeros((len(problem.terms), lengths.size, n_worst), dtype=np.int64)
     for j, h in enumerate(lengths):
         for k, term in enumerate(problem.terms):
             remainder = np.zeros(n)
-            remainder[free] = _term_force(term.assemble(u + h * unit, t, False, None), free, n) - forces[k] \
-                - h * slopes[k]
+            remainder[free] = term.assemble(u + h * unit, t, False, None).residual(n)[free] - forces[k] - h * slopes[k]
             errors[k, j] = np.linalg.norm(remainder)
             nodal = np.linalg.norm(remainder[:n_u].reshape(-1, problem.space.dim), axis=1)
             worst[k, j] = np.argsort(nodal)[::-1][:n_worst]

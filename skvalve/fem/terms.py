@@ -56,6 +56,15 @@ class Contribution:
     blocks: list[Blocks] = field(default_factory=list)
     matrix: sp.spmatrix | None = None
 
+    def residual(self, n_dofs: int) -> np.ndarray:
+        """This term's residual ``internal - external`` on all ``n_dofs`` dofs (zeros where it adds nothing)."""
+        force = np.zeros(n_dofs)
+        if self.internal is not None:
+            force += self.internal
+        if self.external is not None:
+            force -= self.external
+        return force
+
 
 class Term:
     """Base class of problem terms (no-op state handling).
