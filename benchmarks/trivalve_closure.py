@@ -24,6 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from skvalve.fem import linsolve
+from skvalve.fem.contact_blend import DEEP_FADE
 from skvalve.fem.damping import undamped_residual
 from skvalve.fem.soft_modes import soft_modes
 from skvalve.fem.taylor import taylor_test
@@ -66,6 +67,7 @@ OPTION_FLAGS = {
     "contact_ramp": (float, "step-time interval over which the contact penalty rises smoothly to its value"),
     "penalty": (float, "contact penalty (MPa/mm)"),
     "cable_compression": (int, "1: cables that are one input truss carry their law in compression too"),
+    "contact_loaded_faces": (int, "1: the pressure-loaded (ventricular) skins are in contact too"),
 }
 
 
@@ -185,6 +187,9 @@ def main() -> int:
         overrides["max_increment"] = None
     if overrides.get("contact_barrier", 0.0) < 0.0:
         overrides["contact_barrier"] = None
+    for flag in ("cable_compression", "contact_loaded_faces"):
+        if flag in overrides:
+            overrides[flag] = bool(overrides[flag])
     if args.method == "ptc":
         options = ClosureOptions.for_relaxation(model, **overrides)
     else:
@@ -256,7 +261,9 @@ def main() -> int:
         deepest = np.zeros(setup.problem.space.n_scalar)
         np.maximum.at(deepest, pairs.node, np.maximum(-pairs.gap, 0.0))
         print(f"contact overlap: deepest {deepest.max(initial=0.0):.3g} mm of the search depth {depth:.3g} mm; nodes "
-              f"deeper than half of it: {int((deepest > 0.5 * depth).sum())}")
+              f"deeper than half of it: {int((deepest > 0.5 * depth).sum())}, in its fade-out (deeper than "
+              f"{DEEP_FADE} of it, where the penalty energy falls with depth): "
+              f"{int((deepest > DEEP_FADE * depth).sum())}")
         mesh = setup.model.mesh
         corners = hex_corner_jacobians(mesh.p.T + run.u[: setup.problem.space.n_u].reshape(-1, 3),
                                        mesh.t.T[:, np.argsort(ABAQUS_TO_SKFEM_HEX)])  # det(dx/dxi) at each corner

@@ -267,6 +267,31 @@ def test_a_contact_depth_that_is_not_a_positive_length_is_refused(depth):
         ClosureOptions(contact_depth=depth)
 
 
+@pytest.mark.parametrize("flag", [1, "yes", None])
+def test_contact_loaded_faces_must_be_true_or_false(flag):
+    with pytest.raises(ValueError, match="contact_loaded_faces"):
+        ClosureOptions(contact_loaded_faces=flag)
+
+
+@pytest.mark.skipif(DISEASED is None, reason="Texas TriValve input not found (../shared/data)")
+def test_the_pressure_loaded_skins_join_the_contact_surface_on_request():
+    abaqus = read_model(DISEASED)
+    model = valve_model(abaqus)
+    faces = [closure_setup(options=ClosureOptions(contact_depth=0.2, contact_loaded_faces=flag), abaqus=abaqus,
+                           model=model).contact for flag in (False, True)]
+    outer = contact_surface(abaqus, model, ["Leaflet_Surfaces_Outer"])  # the surface the input loads with pressure
+
+    def keys(quads):
+        return {tuple(sorted(quad)) for quad in quads.tolist()}
+
+    assert {load.surface.upper() for load in model.pressures} == {"LEAFLET_SURFACES_OUTER"}
+    assert keys(faces[1].surface.quads) == keys(faces[0].surface.quads) | keys(outer.quads)
+    listed = sum(len(group.elements) for group in abaqus.surface("Leaflet_Surfaces_Outer").faces)
+    assert len(keys(outer.quads)) == listed > 0  # one face per element the input lists
+    # the two skins of a leaflet (0.39 mm apart) never pair: within the reference exclusion distance
+    assert faces[1].active_pairs(np.zeros(faces[1].space.n_dofs)).size == 0
+
+
 def test_reproduce_without_the_shipped_input_exits_with_a_message(monkeypatch, capsys):
     module = reproduce_module
     monkeypatch.setattr(module, "trivalve_input", lambda: None)

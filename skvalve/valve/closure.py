@@ -37,7 +37,7 @@ from ..fem.truss import Truss
 from ..io.abaqus import AbaqusModel, read_model, trivalve_input
 from ..io.files import replace_atomically
 from .model import ValveModel, valve_model
-from .surfaces import contact_surface, thinnest_stack
+from .surfaces import contact_surface, contact_surface_names, thinnest_stack
 
 __all__ = ["ClosureOptions", "ClosureSetup", "ClosureRun", "StagedDamping", "closure_setup", "contact_surface",
            "damping_weights", "load_factors", "run_closure"]
@@ -80,6 +80,11 @@ class ClosureOptions:
     contact_depth : the contact's search depth g_max (mm; ``SurfaceContact`` ``max_penetration``): deeper
     passes are ignored and the clearance limit keeps steps to three quarters of it. ``None``: a quarter of the
     thinnest stack on extruded shells (their two skins a thickness apart must not pair), the mean face edge on bricks.
+    contact_loaded_faces : also put the faces the input loads with pressure (the leaflets' ventricular skins on the
+    1.0 bricks, ``Leaflet_Surfaces_Outer``) in contact. The 1.0 inputs name only the inner (atrial) skins and the rim,
+    so a node that meets another leaflet from its ventricular side enters its solid unopposed and is seen only once
+    it is within the search depth of the inner skin, already in the fade-out; extruded shells are double-sided
+    anyway (:mod:`.surfaces`).
     contact_ramp : the penalty rises from zero at ``contact_from`` to ``penalty`` over this step-time interval (a smooth
     step): folds that overlap when it switches on are pushed apart gradually (switched on at once, three overlapping
     pairs at the free edge of the 1.0 valve threw their nodes by millimetres and stalled the pseudo-time steps at
@@ -125,6 +130,7 @@ class ClosureOptions:
     contact_blend: float = 0.0
     contact_barrier: float | None = None
     contact_depth: float | None = None
+    contact_loaded_faces: bool = False
     cable_slack_fraction: float = 1e-6
     cable_compression: bool = False
     pressure_damping: float = 1e-4
@@ -133,6 +139,9 @@ class ClosureOptions:
         depth = self.contact_depth
         if depth is not None and not (isinstance(depth, (int, float)) and math.isfinite(depth) and depth > 0.0):
             raise ValueError(f"ClosureOptions.contact_depth must be a positive length (mm) or None; got {depth!r}")
+        if not isinstance(self.contact_loaded_faces, (bool, np.bool_)):
+            raise ValueError("ClosureOptions.contact_loaded_faces must be True or False; "
+                             f"got {self.contact_loaded_faces!r}")
 
     @classmethod
     def for_relaxation(cls, model: ValveModel, **overrides) -> ClosureOptions:
@@ -230,7 +239,11 @@ def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: Abaq
         for term in problem.terms:
             if isinstance(term, Truss):
                 term.stiffness_scale = ramp
-    surface = contact_surface(abaqus, model)
+    names = contact_surface_names(abaqus)
+    if options.contact_loaded_faces:
+        taken = {name.upper() for name in names}
+        names += tuple(dict.fromkeys(load.surface for load in model.pressures if load.surface.upper() not in taken))
+    surface = contact_surface(abaqus, model, names)
     # extruded shells: the two skins of one stack face each other a thickness apart; a search depth of a
     # quarter of the thinnest stack keeps them from pairing (bricks: the contact term's default depth)
     thinnest = thinnest_stack(model, abaqus)
