@@ -240,9 +240,8 @@ def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: Abaq
             if isinstance(term, Truss):
                 term.stiffness_scale = ramp
     names = contact_surface_names(abaqus)
-    if options.contact_loaded_faces:
-        taken = {name.upper() for name in names}
-        names += tuple(dict.fromkeys(load.surface for load in model.pressures if load.surface.upper() not in taken))
+    if options.contact_loaded_faces:  # contact_surface keeps a face that two surfaces share once
+        names += tuple(dict.fromkeys(load.surface for load in model.pressures))
     surface = contact_surface(abaqus, model, names)
     # extruded shells: the two skins of one stack face each other a thickness apart; a search depth of a
     # quarter of the thinnest stack keeps them from pairing (bricks: the contact term's default depth)
