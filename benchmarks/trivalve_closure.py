@@ -68,6 +68,7 @@ OPTION_FLAGS = {
     "penalty": (float, "contact penalty (MPa/mm)"),
     "cable_compression": (int, "1: cables that are one input truss carry their law in compression too"),
     "contact_loaded_faces": (int, "1: the pressure-loaded (ventricular) skins are in contact too"),
+    "contact_smoothing": (float, "overlap (mm) over which the contact pressure is rounded as a pair switches on"),
 }
 
 

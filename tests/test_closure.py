@@ -30,6 +30,7 @@ from skvalve.valve.closure import (
     contact_surface,
     load_factors,
     run_closure,
+    write_log,
 )
 from skvalve.valve.model import valve_model
 from skvalve.valve.outputs import ClosureWriter
@@ -133,10 +134,11 @@ def test_held_stages_hand_on_their_state_and_end_where_one_stage_does():
 
 
 
-def test_a_held_relaxation_that_fails_before_its_first_step_reports_the_error_and_keeps_the_start(monkeypatch):
+def test_a_held_relaxation_that_fails_before_its_first_step_reports_the_error_and_keeps_the_start(monkeypatch,
+                                                                                              tmp_path):
     """Resumed at the held load, a trust region that raises at once (a bug, or giving up with no step taken) is
     recorded as the run's error with the load factor of the start, and with the state it was handed as the kept state
-    when the error carries it: no IndexError from an empty history."""
+    when the error carries it: no IndexError from an empty history, and its log is written."""
     ptc = PseudoTransientOptions(damping=0.5, first_step=0.05, max_load_step=0.25, rtol=1e-9, solver="scipy")
     setup = _blocks_setup(0.15, damped=False, blend=0.1)
     u0 = np.zeros(setup.problem.space.n_dofs)
@@ -147,6 +149,9 @@ def test_a_held_relaxation_that_fails_before_its_first_step_reports_the_error_an
     monkeypatch.setattr(relaxation_module, "trust_region", broken)
     run = relax_closure(setup, 1.5, ptc, progress=False, u0=u0, t0=1.5, held=TrustRegionOptions(solver="scipy"))
     assert run.error == "ValueError: einsum failed" and run.load_factors == [1.5] and run.u is None
+    assert run.iterations == [0] and run.contact_pairs == [0]  # the log lists one row per load factor
+    write_log(run, tmp_path / "closure_log.txt")
+    assert "error ValueError: einsum failed" in (tmp_path / "closure_log.txt").read_text()
 
     handed = []
 
@@ -259,12 +264,22 @@ def test_contact_surface_of_the_shipped_valve_lies_on_the_boundary_and_faces_out
     assert default.max_penetration == pytest.approx(edges.mean(), rel=1e-12)
     shallow = closure_setup(options=ClosureOptions(contact_depth=0.2), abaqus=abaqus, model=model).contact
     assert shallow.max_penetration == 0.2
+    # the rounding of the contact pressure: 1 % of the mean face edge unless contact_smoothing sets it
+    assert default.smoothing == pytest.approx(0.01 * edges.mean(), rel=1e-12)
+    rounded = closure_setup(options=ClosureOptions(contact_smoothing=0.05), abaqus=abaqus, model=model).contact
+    assert rounded.smoothing == 0.05
 
 
 @pytest.mark.parametrize("depth", [0.0, -0.1, float("nan"), float("inf"), "0.2"])
 def test_a_contact_depth_that_is_not_a_positive_length_is_refused(depth):
     with pytest.raises(ValueError, match="contact_depth"):
         ClosureOptions(contact_depth=depth)
+
+
+@pytest.mark.parametrize("smoothing", [-0.01, float("nan"), float("inf"), "0.05"])
+def test_a_contact_smoothing_that_is_not_a_length_is_refused(smoothing):
+    with pytest.raises(ValueError, match="contact_smoothing"):
+        ClosureOptions(contact_smoothing=smoothing)
 
 
 @pytest.mark.parametrize("flag", [1, "yes", None])

@@ -85,6 +85,8 @@ class ClosureOptions:
     so a node that meets another leaflet from its ventricular side enters its solid unopposed and is seen only once
     it is within the search depth of the inner skin, already in the fade-out; extruded shells are double-sided
     anyway (:mod:`.surfaces`).
+    contact_smoothing : the overlap (mm) over which the contact pressure is rounded as a pair switches on
+    (:class:`~skvalve.fem.contact.SurfaceContact` ``smoothing``; ``None``: 1 % of the surface's mean face edge).
     contact_ramp : the penalty rises from zero at ``contact_from`` to ``penalty`` over this step-time interval (a smooth
     step): folds that overlap when it switches on are pushed apart gradually (switched on at once, three overlapping
     pairs at the free edge of the 1.0 valve threw their nodes by millimetres and stalled the pseudo-time steps at
@@ -131,6 +133,7 @@ class ClosureOptions:
     contact_barrier: float | None = None
     contact_depth: float | None = None
     contact_loaded_faces: bool = False
+    contact_smoothing: float | None = None
     cable_slack_fraction: float = 1e-6
     cable_compression: bool = False
     pressure_damping: float = 1e-4
@@ -139,6 +142,11 @@ class ClosureOptions:
         depth = self.contact_depth
         if depth is not None and not (isinstance(depth, (int, float)) and math.isfinite(depth) and depth > 0.0):
             raise ValueError(f"ClosureOptions.contact_depth must be a positive length (mm) or None; got {depth!r}")
+        smoothing = self.contact_smoothing
+        if smoothing is not None and not (isinstance(smoothing, (int, float)) and math.isfinite(smoothing)
+                                          and smoothing >= 0.0):
+            raise ValueError("ClosureOptions.contact_smoothing must be a length >= 0 (mm) or None; "
+                             f"got {smoothing!r}")
         if not isinstance(self.contact_loaded_faces, (bool, np.bool_)):
             raise ValueError("ClosureOptions.contact_loaded_faces must be True or False; "
                              f"got {self.contact_loaded_faces!r}")
@@ -253,7 +261,8 @@ def closure_setup(path=None, options: ClosureOptions | None = None, abaqus: Abaq
         _PenaltyFrom(options.penalty, options.contact_from, options.contact_ramp)
     contact = problem.add_term(SurfaceContact(problem.space, surface, penalty, max_penetration=depth,
                                               exclude_within=options.contact_exclude_within,
-                                              blend=options.contact_blend, barrier=options.contact_barrier))
+                                              blend=options.contact_blend, barrier=options.contact_barrier,
+                                              smoothing=options.contact_smoothing))
     damping = None
     if options.damping > 0.0:
         schedule = StagedDamping(options.damping, options.pressure_damping, options.pressure_start,

@@ -171,6 +171,8 @@ def relax_closure(setup: ClosureSetup, end: float,
         run.error = "did not converge"
     if not run.load_factors:  # failed before its first step: the load factor of the kept (or starting) state
         run.load_factors.append(float(getattr(result, "load_factor", first_load)))
+        run.iterations.append(0)
+        run.contact_pairs.append(0)
     if run.u is not None:
         run.undamped_residual = undamped_residual(setup.problem, run.u, run.load_factors[-1])
     return run
