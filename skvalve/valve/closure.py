@@ -139,14 +139,8 @@ class ClosureOptions:
     pressure_damping: float = 1e-4
 
     def __post_init__(self) -> None:
-        depth = self.contact_depth
-        if depth is not None and not (isinstance(depth, (int, float)) and math.isfinite(depth) and depth > 0.0):
-            raise ValueError(f"ClosureOptions.contact_depth must be a positive length (mm) or None; got {depth!r}")
-        smoothing = self.contact_smoothing
-        if smoothing is not None and not (isinstance(smoothing, (int, float)) and math.isfinite(smoothing)
-                                          and smoothing >= 0.0):
-            raise ValueError("ClosureOptions.contact_smoothing must be a length >= 0 (mm) or None; "
-                             f"got {smoothing!r}")
+        _check_length("contact_depth", self.contact_depth, "a positive length (mm)", zero=False)
+        _check_length("contact_smoothing", self.contact_smoothing, "a length >= 0 (mm)", zero=True)
         if not isinstance(self.contact_loaded_faces, (bool, np.bool_)):
             raise ValueError("ClosureOptions.contact_loaded_faces must be True or False; "
                              f"got {self.contact_loaded_faces!r}")
@@ -185,6 +179,14 @@ class ClosureOptions:
             fitted["cable_softening"] = 1.0
         fitted.update(overrides)
         return cls(**fitted)
+
+
+def _check_length(name: str, value, what: str, zero: bool) -> None:
+    """Refuse a ClosureOptions length that is not None, a finite number, and positive (or >= 0 with ``zero``)."""
+    if value is None:
+        return
+    if not (isinstance(value, (int, float)) and math.isfinite(value) and (value >= 0.0 if zero else value > 0.0)):
+        raise ValueError(f"ClosureOptions.{name} must be {what} or None; got {value!r}")
 
 
 @dataclass
