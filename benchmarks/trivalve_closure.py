@@ -39,6 +39,7 @@ from skvalve.valve.closure import (
     run_closure,
     write_log,
 )
+from skvalve.valve.contact_lift import closure_held_nodes, force_limit, lift_parked_nodes
 from skvalve.valve.extrude import hex_corner_jacobians
 from skvalve.valve.model import ABAQUS_TO_SKFEM_HEX, valve_model
 from skvalve.valve.outputs import ClosureWriter, closure_measures
@@ -143,6 +144,11 @@ def main() -> int:
     parser.add_argument("--resume", action="store_true", help="start from --out/last_state.npz")
     parser.add_argument("--report", action="store_true",
                         help="with --resume: measure and draw the kept state (Table 2-3 rows, figures, VTU), no solve")
+    parser.add_argument("--lift-parked", default=None, metavar="LEVEL,TARGET[,MAX_FORCE]",
+                        help="with --resume: first lift the contact nodes parked deeper than LEVEL of the search "
+                             "depth to TARGET of it, each node alone, halving a lift while it folds or squeezes a hex "
+                             "or (with MAX_FORCE, N) loads a vertex of its hexes beyond MAX_FORCE "
+                             "(valve.contact_lift; e.g. 0.7,0.6 or 0.7,0.6,10)")
     parser.add_argument("--soft-modes", type=int, default=0, metavar="K",
                         help="also print the K softest modes of the symmetric tangent at the end (fem.soft_modes)")
     parser.add_argument("--taylor", action="store_true",
@@ -165,6 +171,16 @@ def main() -> int:
     args = parser.parse_args()
     if args.report and not args.resume:
         parser.error("--report needs --resume")
+    if args.lift_parked is not None:
+        if not args.resume or args.report:
+            parser.error("--lift-parked needs --resume (and no --report)")
+        try:
+            level, target, *max_force = (float(value) for value in args.lift_parked.split(","))
+            if len(max_force) > 1:
+                raise ValueError
+        except ValueError:
+            parser.error(f"--lift-parked wants LEVEL,TARGET[,MAX_FORCE] (two or three numbers); got "
+                         f"{args.lift_parked!r}")
     path = trivalve_input() if args.input is None else args.input
     if path is None or not Path(path).exists():
         print("Texas TriValve input not found: set $SKVALVE_TRIVALVE (Mathur et al. 2022, CC BY-NC-SA 4.0)")
@@ -207,6 +223,13 @@ def main() -> int:
             return pairs
 
         setup.contact.active_pairs = logged_search
+    if args.lift_parked is not None:
+        accept = force_limit(setup.problem, t0, max_force[0], setup.model.mesh) if max_force else None
+        lift = lift_parked_nodes(setup.contact, u0, setup.model.mesh, level=level, target=target,
+                                 held=closure_held_nodes(setup), accept=accept)
+        u0 = lift.u
+        print(f"{lift}; undamped residual after it (norm, relative): {undamped_residual(setup.problem, u0, t0)}",
+              flush=True)
     if args.report:  # the kept state, measured and drawn, no solve
         run = ClosureRun(load_factors=[t0], iterations=[0], u=u0)
         setup.contact.assemble(u0, t0, False, None)

@@ -191,3 +191,13 @@ def test_stress_limits_clip_the_colour_range_and_extend_the_bar(setup, tmp_path)
     assert faces.get_clim() == (low, high)
     assert faces.colorbar.extend == "both" and free.colorbar.extend == "neither"
     np.testing.assert_array_equal(faces.get_array(), free.get_array())  # the values are kept, only the map clips
+
+
+def test_an_upper_percentile_caps_the_colour_range_at_that_percentile(setup, tmp_path):
+    u = _displacement(setup, _widening)
+    result = figures.atrial_view_stress(setup, u, 0.0, tmp_path / "capped.png", upper_percentile=50.0)
+    (faces,) = _polys(result.figure)
+    assert faces.get_clim() == pytest.approx((result.stress_kpa.min(), np.median(result.stress_kpa)), rel=1e-12)
+    assert faces.colorbar.extend == "max"
+    with pytest.raises(ValueError, match="upper_percentile"):
+        figures.atrial_view_stress(setup, u, 0.0, tmp_path / "bad.png", upper_percentile=0.0)
