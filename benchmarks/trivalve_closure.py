@@ -15,9 +15,10 @@ Last line: ``trivalve_closure_seconds=<x>``.
 from __future__ import annotations
 
 import argparse
+import json
 import logging
 import sys
-from dataclasses import replace
+from dataclasses import asdict, replace
 from pathlib import Path
 
 import numpy as np
@@ -74,26 +75,29 @@ OPTION_FLAGS = {
 
 
 class LastState:
-    """Callback keeping the last converged (t, u) on disk, atomically."""
+    """Callback keeping the last converged (t, u) on disk, atomically, with the run's ClosureOptions as JSON
+    (``options``: ``skvalve reproduce mathur2022 --state`` rebuilds the model with them)."""
 
-    def __init__(self, folder: Path) -> None:
-        self.path = folder / "last_state.npz"
+    def __init__(self, folder: Path, options: str = "{}") -> None:
+        self.path, self.options = folder / "last_state.npz", options
 
     def __call__(self, event) -> None:
-        replace_atomically(self.path, lambda temporary: np.savez(temporary, t=event.load_factor, u=event.u))
+        replace_atomically(self.path, lambda temporary: np.savez(temporary, t=event.load_factor, u=event.u,
+                                                                  options=self.options))
 
 class BestState:
     """Callback keeping the state with the smallest relative residual at the held load on disk (``best_state.npz``):
     the held residual of a valve with contact rises and falls from step to step."""
 
-    def __init__(self, folder: Path, end: float) -> None:
-        self.path, self.end, self.best = folder / "best_state.npz", end, np.inf
+    def __init__(self, folder: Path, end: float, options: str = "{}") -> None:
+        self.path, self.end, self.best, self.options = folder / "best_state.npz", end, np.inf, options
 
     def __call__(self, event) -> None:
         if event.load_factor >= self.end and event.relative_residual < self.best:
             self.best = float(event.relative_residual)
             replace_atomically(self.path, lambda temporary: np.savez(temporary, t=event.load_factor, u=event.u,
-                                                                      relative_residual=self.best))
+                                                                      relative_residual=self.best,
+                                                                      options=self.options))
 
 #: flags --ptc-<name> that override a PseudoTransientOptions field
 PTC_FLAGS = {
@@ -213,6 +217,7 @@ def main() -> int:
         options = ClosureOptions.for_model(model, **overrides)
     print(f"input {Path(path).name}: {options}", flush=True)
     setup = closure_setup(options=options, abaqus=abaqus, model=model)
+    recorded = json.dumps(asdict(options))  # kept with every state (reproduce mathur2022 --state)
     print("model:", setup.model.counts(), "contact faces:", setup.contact.surface.quads.shape[0], flush=True)
     if args.verbose:
         search = setup.contact.active_pairs
@@ -253,15 +258,15 @@ def main() -> int:
                     tr[key] = tuple(name for name in tr[key].split(",") if name)
             held = held_stages(setup, args.held_projected_steps, rtol=options.rtol, atol=options.atol, **tr)
             print(f"held load: {held}", flush=True)
-        run = relax_closure(setup, options.end, ptc_options, callbacks=[LastState(args.out),
-                                                                         BestState(args.out, options.end)],
+        run = relax_closure(setup, options.end, ptc_options, callbacks=[LastState(args.out, recorded),
+                                                                         BestState(args.out, options.end, recorded)],
                             progress=False, verbose=args.verbose, u0=u0, t0=t0, held=held)
     else:
-        run = run_closure(setup, options, callbacks=[LastState(args.out)], progress=False, verbose=args.verbose,
-                          u0=u0, t0=t0)
+        run = run_closure(setup, options, callbacks=[LastState(args.out, recorded)], progress=False,
+                          verbose=args.verbose, u0=u0, t0=t0)
     if run.u is not None and not args.report:  # the kept state: the best held one when the relaxation gave up
         replace_atomically(args.out / "last_state.npz",
-                           lambda temporary: np.savez(temporary, t=run.load_factors[-1], u=run.u))
+                           lambda temporary: np.savez(temporary, t=run.load_factors[-1], u=run.u, options=recorded))
     write_log(run, args.out / ("report_log.txt" if args.report else "closure_log.txt"))
     print(f"wall time {run.seconds:.1f} s, load steps {len(run.load_factors) - 1}, "
           f"Newton iterations {sum(run.iterations)}, contact pairs at the end "

@@ -1,8 +1,9 @@
 """Command-line interface: ``skvalve materials``, ``skvalve reproduce <paper>``, ``skvalve valve info FILE``.
 
 Exit codes: 0 done; 1 ``--strict`` and a row is a regression or an unexplained disagreement; 2 bad
-arguments, an unusable ``--out``, a paper not available yet or its input data not found (a
-``FileNotFoundError`` from ``reproduce``); 130 interrupted (Ctrl-C).
+arguments, an unusable ``--out``, a paper not available yet, its input data not found (a
+``FileNotFoundError`` from ``reproduce``) or a ``--state`` file it cannot use (``InputError``); 130 interrupted
+(Ctrl-C).
 The heavy modules (numpy, scikit-fem, matplotlib, the papers) are imported inside the commands, so
 ``skvalve --help`` and ``--version`` start fast — the one place skvalve imports inside functions.
 """
@@ -11,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import inspect
 import sys
 import tempfile
 import time
@@ -18,7 +20,7 @@ from pathlib import Path
 
 from . import __version__
 from .papers.registry import PAPERS, Paper
-from .papers.table import Row, Stage, Status, Written, format_header, format_row
+from .papers.table import InputError, Row, Stage, Status, Written, format_header, format_row
 
 EXIT_STRICT, EXIT_USAGE, EXIT_INTERRUPTED = 1, 2, 130
 
@@ -90,8 +92,13 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     print(f"skvalve reproduce {paper.key}{' --full' if args.full else ''}: {paper.citation}")
     print(format_header(), flush=True)
+    extra = {}
+    if args.state is not None:
+        if "state" not in inspect.signature(reproduce).parameters:
+            return _error(f"reproduce {paper.key} does not take --state (only papers whose full runs take hours do)")
+        extra["state"] = Path(args.state)
     try:
-        for item in reproduce(out=out, full=args.full):
+        for item in reproduce(out=out, full=args.full, **extra):
             if isinstance(item, Row):
                 rows.append(item)
                 print(format_row(item), flush=True)
@@ -100,7 +107,7 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
             elif isinstance(item, Written):
                 written.append(item.path)
                 print(f"[{time.perf_counter() - start:6.1f} s] wrote {item.path}", file=sys.stderr, flush=True)
-    except FileNotFoundError as err:  # input data that are not shipped with skvalve (e.g. the TriValve files)
+    except (FileNotFoundError, InputError) as err:  # data not shipped with skvalve, or a kept state it cannot use
         return _error(f"reproduce {paper.key}: {err}")
     except KeyboardInterrupt:
         figures = ", ".join(p.name for p in written) or "none"
@@ -154,6 +161,9 @@ def build_parser() -> argparse.ArgumentParser:
     rep.add_argument("paper", choices=list(PAPERS))
     rep.add_argument("--out", default="skvalve_out", help="folder for the figures (created; must be writable)")
     rep.add_argument("--full", action="store_true", help="converged meshes and complete sweeps (slow)")
+    rep.add_argument("--state", default=None, metavar="FILE",
+                     help="mathur2022: measure a kept closure state (benchmarks/trivalve_closure.py's last_state.npz) "
+                          "instead of running the closure")
     rep.add_argument("--strict", action="store_true",
                      help="exit 1 if a row is a regression or an unexplained disagreement with the paper")
     rep.set_defaults(func=_cmd_reproduce)

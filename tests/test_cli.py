@@ -5,12 +5,13 @@ The commands' numbers are tested elsewhere; here stand-in ``reproduce`` modules 
 
 import sys
 import types
+from pathlib import Path
 
 import pytest
 
 import skvalve
 from skvalve.cli import build_parser, main
-from skvalve.papers.table import Reason, Row, Source, Stage, Written
+from skvalve.papers.table import InputError, Reason, Row, Source, Stage, Written
 
 FAKE = "skvalve.papers.mathur2022.reproduce"
 
@@ -132,3 +133,23 @@ def test_missing_input_data_is_one_line_and_exit_2(monkeypatch, tmp_path, capsys
     assert main(["reproduce", "mathur2022", "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1] == "skvalve: reproduce mathur2022: input not found: set $SKVALVE_TRIVALVE"
+
+
+def test_state_goes_only_to_a_reproduce_that_takes_it(monkeypatch, tmp_path, capsys):
+    _fake_paper(monkeypatch, [Row("a", 1.0, 1.0, 0.1)])  # reproduce(out, full): no state
+    assert main(["reproduce", "mathur2022", "--out", str(tmp_path), "--state", "kept.npz"]) == 2
+    assert "does not take --state" in capsys.readouterr().err
+    module = types.ModuleType(FAKE)
+    seen = []
+
+    def reproduce(out, full, state=None):
+        seen.append(state)
+        raise InputError(f"kept state {state}: no u in it")
+        yield  # a generator, as the papers' are
+
+    module.reproduce = reproduce
+    monkeypatch.setitem(sys.modules, FAKE, module)
+    assert main(["reproduce", "mathur2022", "--out", str(tmp_path), "--state", "kept.npz"]) == 2
+    assert seen == [Path("kept.npz")]
+    assert capsys.readouterr().err.strip().splitlines()[-1] == \
+        "skvalve: reproduce mathur2022: kept state kept.npz: no u in it"

@@ -19,7 +19,13 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["Source", "Reason", "Status", "Row", "Stage", "Written", "format_header", "format_row", "format_table"]
+__all__ = ["InputError", "Source", "Reason", "Status", "Row", "Stage", "Written", "format_header", "format_row",
+           "format_table"]
+
+
+class InputError(ValueError):
+    """A file given to a paper's ``reproduce`` that it cannot use (the message names the file and what is wrong);
+    ``skvalve reproduce`` prints it and exits 2."""
 
 
 class Source(enum.Enum):
