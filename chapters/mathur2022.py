@@ -632,5 +632,10 @@ if HAVE_DATA:
 # * `benchmarks/trivalve_closure.py --out DIR` runs the same closure and reports wall time, pseudo-steps, rejected
 #   steps, contact pairs and peak memory (`--resume` restarts from the last state kept on disk; `--resume --report`
 #   measures and draws it).
+# * A chain of such runs, resumed with the contact search depth at half the leaflet, the depth barrier, the loaded
+#   skins in contact and the nodes parked in the penalty's fade-out lifted out of it
+#   (`skvalve.valve.contact_lift.lift_parked_nodes`, `--lift-parked`), brought the held diseased valve to the residual
+#   asked for; the documentation's mathur2022 page lists the runs and their rows beside the paper's, and
+#   `skvalve reproduce mathur2022 --state DIR/last_state.npz` prints the Table 2–3 rows of any kept state.
 #
 # Both need the authors' input files (`$SKVALVE_TRIVALVE`) and take far longer than this notebook on two cores.
