@@ -4,10 +4,11 @@ slides over a concave crease (where the closest-triangle rule jumps), and no sea
 
 import numpy as np
 import pytest
+import skfem
 from test_contact import block_contact_problem, closed_form_force, pair_central_differences
 
-from skvalve.fem import contact_blend, solve
-from skvalve.fem.contact import SurfaceContact
+from skvalve.fem import Space, contact_blend, solve
+from skvalve.fem.contact import ContactSurface, SurfaceContact
 from skvalve.fem.contact_blend import free_edges, normalisation, sheets, weighted_mean_energy
 from skvalve.fem.contact_geometry import barycentric_derivatives, smooth_step
 
@@ -240,3 +241,30 @@ def test_a_node_between_two_sheets_feels_each_in_full():
     for groups, expected in ((group, 2.0 * 0.5), (np.zeros(3, dtype=int), 2.0 * 0.5 / 1.8)):
         _, _, energy = weighted_mean_energy(node, groups, dofs, area, phi, zeros, hess, psi, zeros, hess, 63, True)
         assert energy == pytest.approx(expected)
+
+
+def test_each_triangles_own_search_radius_misses_no_pair_on_a_graded_surface():
+    """Triangles of very different sizes (the bottom face graded 0.05 to 0.65 across, the top one uniform): the search
+    with each triangle's own radius finds exactly the pairs of a search of every node against every triangle, for
+    both contact rules, with the top face slid over a grid of offsets."""
+    graded = np.array([0.0, 0.05, 0.15, 0.35, 1.0])
+    bottom = skfem.MeshHex.init_tensor(graded, graded, np.linspace(0.0, 1.0, 3))
+    top = skfem.MeshHex.init_tensor(*(np.linspace(0.0, 1.0, 4),) * 2, np.linspace(1.0, 2.0, 3))
+    mesh = skfem.MeshHex(np.hstack([bottom.p, top.p]), np.hstack([bottom.t, top.t + bottom.p.shape[1]]))
+    surface = ContactSurface.from_facets(mesh, mesh.facets_satisfying(lambda X: np.isclose(X[2], 1.0), True))
+    upper = np.arange(mesh.p.shape[1]) >= bottom.p.shape[1]
+    for blend in (0.0, BLEND):
+        contact = SurfaceContact(Space(mesh), surface, 30.0, max_penetration=0.04, blend=blend)
+        radii = contact.search_radius(*(lambda c: (c, c.mean(axis=1)))(mesh.p.T[surface.triangles]))
+        assert radii.max() > 5.0 * radii.min()  # the per-triangle radius matters here
+        for sx in np.linspace(0.0, 0.3, 7):
+            for sy in np.linspace(0.0, 0.3, 7):
+                u = np.zeros(3 * mesh.p.shape[1])
+                u[0::3][upper], u[1::3][upper], u[2::3][upper] = sx, sy, -0.02
+                found = contact.active_pairs(u)
+                contact.search_radius = lambda corners, centroid: np.inf
+                everything = contact.active_pairs(u)
+                del contact.search_radius
+                assert found.size > 0
+                assert np.array_equal(found.node, everything.node)
+                assert np.array_equal(found.triangle, everything.triangle)
