@@ -10,7 +10,7 @@ from test_contact import block_contact_problem, closed_form_force, pair_central_
 from skvalve.fem import Space, contact_blend, solve
 from skvalve.fem.contact import ContactSurface, SurfaceContact
 from skvalve.fem.contact_blend import free_edges, normalisation, sheets, weighted_mean_energy
-from skvalve.fem.contact_geometry import barycentric_derivatives, smooth_step
+from skvalve.fem.contact_geometry import barycentric_derivatives, near_pairs, smooth_step
 
 BLEND = 0.1
 
@@ -268,3 +268,16 @@ def test_each_triangles_own_search_radius_misses_no_pair_on_a_graded_surface():
                 assert found.size > 0
                 assert np.array_equal(found.node, everything.node)
                 assert np.array_equal(found.triangle, everything.triangle)
+
+
+def test_near_pairs_lists_every_point_within_each_centres_own_radius():
+    """Against all pairs' distances: per-centre radii and one scalar radius, sorted by point then centre."""
+    rng = np.random.default_rng(7)
+    points, centres = rng.random((200, 3)), rng.random((50, 3))
+    distance = np.linalg.norm(points[:, None] - centres[None], axis=2)
+    for radius in (rng.uniform(0.01, 0.4, 50), 0.2):
+        point, centre = near_pairs(points, centres, radius)
+        expected = np.argwhere(distance <= np.broadcast_to(radius, (50,))[None])
+        np.testing.assert_array_equal(np.column_stack([point, centre]), expected)  # argwhere: row-major order
+    empty = near_pairs(points, centres + 10.0, 0.1)
+    assert empty[0].size == empty[1].size == 0

@@ -28,8 +28,24 @@ Derivatives are with respect to the twelve coordinates :math:`[x_s, x_1, x_2, x_
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 
-__all__ = ["barycentric", "barycentric_derivatives", "gap_derivatives", "plane_gap", "smooth_step"]
+__all__ = ["barycentric", "barycentric_derivatives", "gap_derivatives", "near_pairs", "plane_gap", "smooth_step"]
+
+
+def near_pairs(points: np.ndarray, centres: np.ndarray, radius) -> tuple[np.ndarray, np.ndarray]:
+    """Every (point, centre) index pair with the point within the centre's own ``radius`` (a scalar or one per
+    centre), sorted by point, then centre: a k-d tree of the points queried at the centres (one radius for all, the
+    largest, listed millions of candidates on a valve surface whose triangles differ in size)."""
+    radius = np.broadcast_to(np.asarray(radius, dtype=float), (len(centres),))
+    lists = cKDTree(points).query_ball_point(centres, radius)
+    counts = np.fromiter((len(item) for item in lists), dtype=np.int64, count=len(lists))
+    if counts.sum() == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    centre = np.repeat(np.arange(len(centres)), counts)
+    point = np.concatenate([np.asarray(item, dtype=np.int64) for item in lists if item])
+    order = np.lexsort((centre, point))
+    return point[order], centre[order]
 
 
 def plane_gap(xs: np.ndarray, corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
