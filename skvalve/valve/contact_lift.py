@@ -15,17 +15,18 @@ in the node's position along the normal), inside the barrier's range where the e
 sheet is the pair with the largest facing factor among the node's pairs deeper than half the depth (blended contact)
 or the node's one pair (closest-triangle rule).
 
-Each node moves alone; a move that would fold one of the node's own hexes (a corner Jacobian of the trilinear map
-:math:`\le 0`, or below its value before the move where it was already folded) or change the stretch
-:math:`\lvert x_i - x_j\rvert / \lvert X_i - X_j\rvert` to any other vertex :math:`j` of those hexes by more than
-``max_stretch_change`` (0.2, the trust region's bound per step: a node moved through the thickness of its own
-0.1 mm hex layer squeezes it, and the exponential Lee–Sacks law then answers with forces of 1e9 N) is halved, up to
-``halvings`` times,
-and the node is left where it is (listed in ``refused``) if none is safe. Nodes with a prescribed displacement or
-at the end of a constraint link never move (``held``; :func:`closure_held_nodes` lists them for a closure: a lifted
-annuloplasty node tied to the ring by a stiff LINK bar raised the residual from 0.1 to 1e9 N). Lifted nodes may
-uncover others, so the search repeats ``sweeps`` times. The moved state is not an equilibrium: the relaxation
-starts again from it.
+Each node moves alone (``columns=True``: with the vertices behind it through its own sheet, which keeps the sheet's
+thickness but shears its neighbours). A move is halved, up to ``halvings`` times, while it would fold one of the
+moved vertices' hexes (a corner Jacobian of the trilinear map :math:`\le 0`, or below its value before the move where
+it was already folded), change the stretch :math:`\lvert x_i - x_j\rvert / \lvert X_i - X_j\rvert` to another
+vertex :math:`j` of those hexes by more than ``max_stretch_change`` (0.2, the trust region's bound per step), or fail
+``accept``; the node is left where it is (listed in ``refused``) if no halved move passes. The stretch bound does not
+bound the forces: the loaded Texas TriValve leaflets sit deep in their exponential law, where lifts within it met
+210 N (1.0 diseased) and 8e8 N (1.0 annuloplasty) at one node; :func:`force_limit` as ``accept`` halves such lifts
+until the forces stay below a limit (one assembly per trial). Nodes with a prescribed displacement or at the end of
+a constraint link never move (``held``; :func:`closure_held_nodes` lists them for a closure), nor do columns that
+reach them. Lifted nodes may uncover others, so the search repeats ``sweeps`` times; a node whose lift was halved
+may move again in the next sweep. The moved state is not an equilibrium: the relaxation starts again from it.
 """
 
 from __future__ import annotations
@@ -56,7 +57,7 @@ class ParkedLift:
     """What :func:`lift_parked_nodes` did: the moved displacement and, per lifted node, the lift (mm)."""
 
     u: np.ndarray
-    lifted: np.ndarray       # (k,) scalar node ids, in the order they moved
+    lifted: np.ndarray       # (k,) scalar node ids, in the order they moved (a node once per sweep it moved in)
     lifts: np.ndarray        # (k,) distance moved along the facing normal
     refused: np.ndarray      # nodes past the level that no halved lift moved (folds, stretch, held, ``accept``)
     deeper_before: int       # nodes deeper than the level before
