@@ -75,29 +75,30 @@ OPTION_FLAGS = {
 
 
 class LastState:
-    """Callback keeping the last converged (t, u) on disk, atomically, with the run's ClosureOptions as JSON
-    (``options``: ``skvalve reproduce mathur2022 --state`` rebuilds the model with them)."""
+    """Callback keeping the last converged (t, u) on disk, atomically, with what ``recorded`` holds (the run's
+    ClosureOptions as JSON ``options`` and the ``input`` file's name: ``skvalve reproduce mathur2022 --state``
+    rebuilds the model with them and refuses a state of another input)."""
 
-    def __init__(self, folder: Path, options: str = "{}") -> None:
-        self.path, self.options = folder / "last_state.npz", options
+    def __init__(self, folder: Path, recorded: dict | None = None) -> None:
+        self.path, self.recorded = folder / "last_state.npz", recorded or {}
 
     def __call__(self, event) -> None:
         replace_atomically(self.path, lambda temporary: np.savez(temporary, t=event.load_factor, u=event.u,
-                                                                  options=self.options))
+                                                                  **self.recorded))
 
 class BestState:
     """Callback keeping the state with the smallest relative residual at the held load on disk (``best_state.npz``):
     the held residual of a valve with contact rises and falls from step to step."""
 
-    def __init__(self, folder: Path, end: float, options: str = "{}") -> None:
-        self.path, self.end, self.best, self.options = folder / "best_state.npz", end, np.inf, options
+    def __init__(self, folder: Path, end: float, recorded: dict | None = None) -> None:
+        self.path, self.end, self.best, self.recorded = folder / "best_state.npz", end, np.inf, recorded or {}
 
     def __call__(self, event) -> None:
         if event.load_factor >= self.end and event.relative_residual < self.best:
             self.best = float(event.relative_residual)
             replace_atomically(self.path, lambda temporary: np.savez(temporary, t=event.load_factor, u=event.u,
                                                                       relative_residual=self.best,
-                                                                      options=self.options))
+                                                                      **self.recorded))
 
 #: flags --ptc-<name> that override a PseudoTransientOptions field
 PTC_FLAGS = {
@@ -217,7 +218,7 @@ def main() -> int:
         options = ClosureOptions.for_model(model, **overrides)
     print(f"input {Path(path).name}: {options}", flush=True)
     setup = closure_setup(options=options, abaqus=abaqus, model=model)
-    recorded = json.dumps(asdict(options))  # kept with every state (reproduce mathur2022 --state)
+    recorded = {"options": json.dumps(asdict(options)), "input": Path(path).name}  # kept with every state
     print("model:", setup.model.counts(), "contact faces:", setup.contact.surface.quads.shape[0], flush=True)
     if args.verbose:
         search = setup.contact.active_pairs
@@ -266,7 +267,7 @@ def main() -> int:
                           verbose=args.verbose, u0=u0, t0=t0)
     if run.u is not None and not args.report:  # the kept state: the best held one when the relaxation gave up
         replace_atomically(args.out / "last_state.npz",
-                           lambda temporary: np.savez(temporary, t=run.load_factors[-1], u=run.u, options=recorded))
+                           lambda temporary: np.savez(temporary, t=run.load_factors[-1], u=run.u, **recorded))
     write_log(run, args.out / ("report_log.txt" if args.report else "closure_log.txt"))
     print(f"wall time {run.seconds:.1f} s, load steps {len(run.load_factors) - 1}, "
           f"Newton iterations {sum(run.iterations)}, contact pairs at the end "

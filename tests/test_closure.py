@@ -134,6 +134,20 @@ def test_held_stages_hand_on_their_state_and_end_where_one_stage_does():
 
 
 
+def test_a_relaxation_resumed_at_its_converged_state_keeps_it():
+    """Resumed from the equilibrium it reached, the held trust region takes no step (none is recorded): the run still
+    keeps that state, with its undamped residual (it kept none, and a resumed converged valve was not measured)."""
+    ptc = PseudoTransientOptions(damping=0.5, first_step=0.05, max_load_step=0.25, rtol=1e-9, solver="scipy")
+    held = TrustRegionOptions(rtol=1e-9, solver="scipy")
+    first = relax_closure(_blocks_setup(0.15, damped=False, blend=0.1), 1.5, ptc, progress=False, held=held)
+    assert first.error is None and first.undamped_residual[1] < 1e-9
+    again = relax_closure(_blocks_setup(0.15, damped=False, blend=0.1), 1.5, ptc, progress=False, held=held,
+                          u0=first.u, t0=1.5)
+    assert again.error is None and again.load_factors == [1.5]
+    np.testing.assert_array_equal(again.u, first.u)
+    assert again.undamped_residual[1] < 1e-9
+
+
 def test_a_held_relaxation_that_fails_before_its_first_step_reports_the_error_and_keeps_the_start(monkeypatch,
                                                                                               tmp_path):
     """Resumed at the held load, a trust region that raises at once (a bug, or giving up with no step taken) is

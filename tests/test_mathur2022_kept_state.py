@@ -68,7 +68,7 @@ def test_kept_states_of_the_valve_are_checked_and_measured(tmp_path):
     np.savez(zero, t=0.0, u=np.zeros(setup.problem.space.n_dofs))
     items = list(reproduce(state=zero))
     stages = " ".join(item.text for item in items if isinstance(item, Stage))
-    assert "not converged" in stages and "step time 0" in stages
+    assert "not converged" in stages and "step time 0" in stages and "input not recorded" in stages
     rows = {row.quantity: row for row in items if isinstance(row, Row)}
     area = rows["Table 2 leaflet area, diseased (mm²)"]
     opened = closure_measures(setup, np.zeros(setup.problem.space.n_dofs), 0.0).leaflet_area["mid"]
@@ -78,3 +78,13 @@ def test_kept_states_of_the_valve_are_checked_and_measured(tmp_path):
     assert rows["Table 2 coaptation area, diseased (mm²)"].skvalve == 0.0  # nothing touches when open
     assert rows["Table 2 orifice area, diseased (mm²; closed valve)"].skvalve == pytest.approx(
         closure_measures(setup, np.zeros(setup.problem.space.n_dofs), 0.0).orifice["mid"], rel=1e-12)
+
+
+@pytest.mark.skipif(trivalve_input() is None, reason="Texas TriValve input not found (../shared/data)")
+def test_a_state_of_another_input_is_refused_by_name(tmp_path):
+    """The annuloplasty valve shares the diseased valve's mesh, so only the recorded input name tells them apart."""
+    path = tmp_path / "annuloplasty.npz"
+    np.savez(path, t=1.5, u=np.zeros(3), input="Annuloplasty_QuasiStatic.inp")
+    assert read_kept_state(path).input == "Annuloplasty_QuasiStatic.inp"
+    with pytest.raises(InputError, match="computed from Annuloplasty_QuasiStatic.inp, not Diseased_QuasiStatic.inp"):
+        next(reproduce(state=path))

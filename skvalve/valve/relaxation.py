@@ -169,6 +169,8 @@ def relax_closure(setup: ClosureSetup, end: float,
         run.seconds = time.perf_counter() - start
     if result is not None and run.error is None and not result.converged:
         run.error = "did not converge"
+    if run.u is None and run.error is None and result is not None:  # converged at its start: no step recorded it
+        run.u = result.u
     if not run.load_factors:  # failed before its first step: the load factor of the kept (or starting) state
         run.load_factors.append(float(getattr(result, "load_factor", first_load)))
         run.iterations.append(0)

@@ -17,7 +17,8 @@ early, the rows are those of the last converged state, marked with the step time
 
 ``state=FILE`` (``skvalve reproduce mathur2022 --state FILE``): the same rows for a kept state of a closure run
 (``benchmarks/trivalve_closure.py`` writes ``last_state.npz`` and ``best_state.npz``: step time ``t``, displacement
-``u`` and, from this version on, the run's ``ClosureOptions`` as JSON ``options``), without solving; the
+``u`` and, from this version on, the run's ``ClosureOptions`` as JSON ``options`` and its ``input`` file's name,
+checked against the diseased input: the repairs share its mesh), without solving; the
 undamped residual of the state is printed, and a state short of the end time or above the residual asked for is
 marked incomplete. A state without ``options`` is measured with :data:`KEPT_STATE_OPTIONS`, those with which the
 held 1.0 diseased valve converged (docs/mathur2022.md).
@@ -75,6 +76,7 @@ class KeptState:
     t: float
     u: np.ndarray
     options: dict | None
+    input: str | None = None  # the name of the input file the state was computed from, when recorded
 
     def closure_options(self, model) -> ClosureOptions:
         """The recorded options, or :meth:`ClosureOptions.for_relaxation` with :data:`KEPT_STATE_OPTIONS`."""
@@ -98,6 +100,7 @@ def read_kept_state(path: Path) -> KeptState:
                 raise InputError(f"kept state {path}: no {', '.join(sorted(missing))} in it (has {data.files})")
             t, u = float(data["t"]), np.asarray(data["u"], dtype=float)
             options = json.loads(str(data["options"])) if "options" in data.files else None
+            source = str(data["input"]) if "input" in data.files else None
     except (OSError, ValueError, zipfile.BadZipFile) as err:
         if isinstance(err, InputError):
             raise
@@ -106,7 +109,7 @@ def read_kept_state(path: Path) -> KeptState:
         raise InputError(f"kept state {path}: t and u must be finite and u one-dimensional")
     if options is not None and not isinstance(options, dict):
         raise InputError(f"kept state {path}: options must be a JSON object of ClosureOptions fields")
-    return KeptState(t, u, options)
+    return KeptState(t, u, options, source)
 
 
 def _require_input() -> Path:
@@ -124,6 +127,10 @@ def reproduce(out: Path | None = None, full: bool = False,
     """Yield the Table 2–3 rows (module docstring); exits with code 2 when the shipped input is absent."""
     path = _require_input()
     kept = read_kept_state(state) if state is not None else None
+    if kept is not None and kept.input is not None and kept.input != path.name:
+        raise InputError(f"kept state {state} was computed from {kept.input}, not {path.name} (Table 2-3 rows here "
+                         "are of the diseased valve; measure other valves with benchmarks/trivalve_closure.py "
+                         "--resume --report --input FILE)")
     yield Stage(f"reading {path.name} and building the implicit model with contact ({CREDIT})")
     abaqus = read_model(path)
     model = valve_model(abaqus)
@@ -146,8 +153,9 @@ def reproduce(out: Path | None = None, full: bool = False,
         complete = kept.t >= options.end and residual[1] <= options.rtol
         state_text = (f"kept state {Path(state).name} at step time {kept.t:.3g}, relative residual {residual[1]:.3g}"
                       f" ({'converged' if complete else 'not converged: rtol ' + format(options.rtol, 'g')})")
-        yield Stage(f"{state_text}; contact {options.contact_depth} mm deep, barrier {options.contact_barrier}, "
-                    f"loaded skins {options.contact_loaded_faces}")
+        source = f"input {kept.input}" if kept.input else f"input not recorded in the state: taken to be {path.name}"
+        yield Stage(f"{state_text}; {source}; contact {options.contact_depth} mm deep, barrier "
+                    f"{options.contact_barrier}, loaded skins {options.contact_loaded_faces}")
         if out is not None:
             ClosureWriter(Path(out) / "mathur2022_kept_state.pvd", setup).write(kept.t, kept.u)
             yield Written(Path(out) / "mathur2022_kept_state.pvd")
