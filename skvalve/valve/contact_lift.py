@@ -75,12 +75,22 @@ def _parked(contact: SurfaceContact, u: np.ndarray, level: float) -> tuple[np.nd
     return np.unique(pairs.node[overlap > level * contact.max_penetration]), pairs
 
 
+def _grouped(keys: np.ndarray, values: np.ndarray, n: int) -> list[np.ndarray]:
+    """For each key 0..n-1, the values listed with it (in their order)."""
+    order = np.argsort(keys, kind="stable")
+    starts = np.searchsorted(keys[order], np.arange(n + 1))
+    return np.split(values[order], starts[1:-1])
+
+
 def _neighbours(mesh: skfem.MeshHex) -> list[np.ndarray]:
     """Each vertex's neighbours along the hex edges."""
     ends = np.hstack([mesh.edges, mesh.edges[::-1]])
-    order = np.argsort(ends[0], kind="stable")
-    starts = np.searchsorted(ends[0][order], np.arange(mesh.p.shape[1] + 1))
-    return [ends[1][order][starts[k]:starts[k + 1]] for k in range(mesh.p.shape[1])]
+    return _grouped(ends[0], ends[1], mesh.p.shape[1])
+
+
+def _cells_of_vertices(mesh: skfem.MeshHex) -> list[np.ndarray]:
+    """Each vertex's hexes."""
+    return _grouped(mesh.t.T.ravel(), np.repeat(np.arange(mesh.t.shape[1]), mesh.t.shape[0]), mesh.p.shape[1])
 
 
 def _column(node: int, direction: np.ndarray, x: np.ndarray, neighbours: list[np.ndarray]) -> list[int]:
@@ -121,10 +131,7 @@ def lift_parked_nodes(contact: SurfaceContact, u: np.ndarray, mesh: skfem.MeshHe
         raise ValueError(f"lift_parked_nodes: u must hold {n_u} finite displacement values")
     depth, X = contact.max_penetration, mesh.p.T
     hexes = mesh.t.T[:, np.argsort(ABAQUS_TO_SKFEM_HEX)]
-    cells_of = [[] for _ in range(X.shape[0])]
-    for cell, corners in enumerate(mesh.t.T):
-        for vertex in corners:
-            cells_of[vertex].append(cell)
+    cells_of = _cells_of_vertices(mesh)
     neighbours = _neighbours(mesh) if columns else None
     is_held = np.zeros(X.shape[0], dtype=bool)
     if held is not None:
@@ -203,10 +210,7 @@ def force_limit(problem: Problem, t: float, max_force: float, mesh: skfem.MeshHe
         raise ValueError(f"force_limit: max_force must be positive; got {max_force!r}")
     fixed = problem.pattern.fixed
     n_u = problem.space.n_u
-    incident = [[] for _ in range(mesh.p.shape[1])]
-    for cell, corners in enumerate(mesh.t.T):
-        for vertex in corners:
-            incident[vertex].append(cell)
+    incident = _cells_of_vertices(mesh)
 
     def accept(trial: np.ndarray, moved: list[int]) -> bool:
         try:

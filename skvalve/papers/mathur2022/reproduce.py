@@ -87,8 +87,8 @@ class KeptState:
 
 
 def read_kept_state(path: Path) -> KeptState:
-    """Read ``t``, ``u`` and ``options`` (JSON of the ClosureOptions fields; None when absent) from an ``.npz``
-    file; :class:`InputError` naming the file for anything else."""
+    """Read ``t``, ``u``, ``options`` (JSON of the ClosureOptions fields) and ``input`` (the input file's name; both
+    None when absent) from an ``.npz`` file; :class:`InputError` naming the file for anything else."""
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"kept state {path} not found (benchmarks/trivalve_closure.py writes "
@@ -101,9 +101,9 @@ def read_kept_state(path: Path) -> KeptState:
             t, u = float(data["t"]), np.asarray(data["u"], dtype=float)
             options = json.loads(str(data["options"])) if "options" in data.files else None
             source = str(data["input"]) if "input" in data.files else None
+    except InputError:
+        raise
     except (OSError, ValueError, zipfile.BadZipFile) as err:
-        if isinstance(err, InputError):
-            raise
         raise InputError(f"kept state {path}: not a readable .npz state ({err})") from err
     if u.ndim != 1 or not np.all(np.isfinite(u)) or not np.isfinite(t):
         raise InputError(f"kept state {path}: t and u must be finite and u one-dimensional")
