@@ -25,7 +25,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from skvalve.fem import linsolve
-from skvalve.fem.contact_blend import DEEP_FADE
+from skvalve.fem.contact.blend import DEEP_FADE
 from skvalve.fem.damping import undamped_residual
 from skvalve.fem.soft_modes import soft_modes
 from skvalve.fem.taylor import taylor_test

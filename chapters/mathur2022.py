@@ -621,9 +621,9 @@ if HAVE_DATA:
 #   conservative, so close to equilibrium that energy is only approximate; below a relative residual of 1e-4 each step
 #   first tries Newton's step with the full tangent and keeps it when the residual halves. Every step, damped or not,
 #   is cut where it would carry a contact node deeper than ¾ of the search depth through a leaflet
-#   (`skvalve.fem.contact_clearance`: the gap of each near node-triangle pair followed along the step; sliding is
+#   (`skvalve.fem.contact.clearance`: the gap of each near node-triangle pair followed along the step; sliding is
 #   free): past that depth the penalty fades out and would let the node through. A node that the forces press
-#   to that floor stops every step there; `SurfaceContact(barrier=...)` (`skvalve.fem.contact_laws`) adds a log
+#   to that floor stops every step there; `SurfaceContact(barrier=...)` (`skvalve.fem.contact.laws`) adds a log
 #   barrier that grows without bound towards the floor and so meets such a force first (off by default: on the
 #   valve, pairs already deep when the contact switches on fade out through its height). It prints all Table 2–3
 #   rows of the diseased column, with a VTU/PVD

@@ -1,4 +1,4 @@
-"""Blended contact (skvalve.fem.contact_blend): barycentric derivatives and the blended energy's force and tangent
+"""Blended contact (skvalve.fem.contact.blend): barycentric derivatives and the blended energy's force and tangent
 against central differences, the closed-form block contact kept exactly, a force that stays continuous where a node
 slides over a concave crease (where the closest-triangle rule jumps), and no search memory."""
 
@@ -7,10 +7,11 @@ import pytest
 import skfem
 from test_contact import block_contact_problem, closed_form_force, pair_central_differences
 
-from skvalve.fem import Space, contact_blend, solve
+from skvalve.fem import Space, solve
+from skvalve.fem.contact import blend as contact_blend
 from skvalve.fem.contact import ContactSurface, SurfaceContact
-from skvalve.fem.contact_blend import free_edges, normalisation, sheets, weighted_mean_energy
-from skvalve.fem.contact_geometry import barycentric_derivatives, near_pairs, smooth_step
+from skvalve.fem.contact.blend import free_edges, normalisation, sheets, weighted_mean_energy
+from skvalve.fem.contact.geometry import barycentric_derivatives, near_pairs, smooth_step
 
 BLEND = 0.1
 

@@ -1,4 +1,4 @@
-"""The contact clearance limit (:mod:`skvalve.fem.contact_clearance`): it lets a surface move rigidly as far as it
+"""The contact clearance limit (:mod:`skvalve.fem.contact.clearance`): it lets a surface move rigidly as far as it
 likes, holds an approaching face to half the search depth, and keeps the trust region from carrying a block through
 another, which it does without it."""
 
@@ -10,8 +10,8 @@ import skfem
 
 from skvalve.fem import HyperelasticTerm, MaterialRegions, Problem, Space
 from skvalve.fem.contact import ContactSurface, SurfaceContact
-from skvalve.fem.contact_blend import free_edges
-from skvalve.fem.contact_clearance import clearance_fraction
+from skvalve.fem.contact.blend import free_edges
+from skvalve.fem.contact.clearance import clearance_fraction
 from skvalve.fem.damping import lumped_volume
 from skvalve.fem.ptc import PseudoTransientOptions, pseudo_transient
 from skvalve.fem.trust_region import TrustRegionOptions, trust_region

@@ -1,4 +1,4 @@
-"""Contact pressure laws (skvalve.fem.contact_laws): energy, pressure and stiffness consistent by central differences,
+"""Contact pressure laws (skvalve.fem.contact.laws): energy, pressure and stiffness consistent by central differences,
 the barrier's closed form, C^2 onset and unbounded growth, and two blocks pressed together hard: the penalty alone
 lets them overlap past the clearance floor; with the barrier they stop short of it at the closed-form overlap."""
 
@@ -14,9 +14,9 @@ from test_contact_clearance import _overlap as clearance_overlap
 
 from skvalve.analytic.homogeneous import uniaxial
 from skvalve.fem import solve
-from skvalve.fem.contact_blend import BARRIER_FLOOR
-from skvalve.fem.contact_clearance import ALLOWED_DEPTH, clearance_fraction
-from skvalve.fem.contact_laws import BARRIER_CUTOFF, depth_barrier, rounded_penalty
+from skvalve.fem.contact.blend import BARRIER_FLOOR
+from skvalve.fem.contact.clearance import ALLOWED_DEPTH, clearance_fraction
+from skvalve.fem.contact.laws import BARRIER_CUTOFF, depth_barrier, rounded_penalty
 from skvalve.fem.errors import ConvergenceError
 from skvalve.fem.trust_region import TrustRegionOptions, trust_region
 

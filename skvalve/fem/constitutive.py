@@ -198,6 +198,18 @@ class MaterialRegions:
         else:
             raise TypeError("materials must be a Hyperelastic law, a {subdomain: law} mapping or a sequence of laws")
 
+    def energy_density(self, F: np.ndarray) -> np.ndarray | None:
+        r"""Strain energy per reference volume :math:`\psi(C)` at the quadrature points (nqp, nel), or ``None`` when
+        a region's law has no ``energy_C`` (quadrature-point materials) or is incompressible (mixed formulation)."""
+        C = np.einsum("kiqe,kjqe->ijqe", F, F)
+        W = np.zeros(F.shape[2:])
+        for region in self.regions:
+            law = region.material
+            if region.volumetric is not None or law.incompressible or not isinstance(law, Hyperelastic):
+                return None
+            W[:, region.elements] = law.energy_C(C[:, :, :, region.elements])
+        return W
+
     def _check_covered(self, owner: np.ndarray) -> None:
         missing = np.flatnonzero(owner < 0)
         if missing.size:

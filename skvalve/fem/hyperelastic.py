@@ -80,6 +80,16 @@ class HyperelasticTerm(Term):
         internal = np.bincount(sp_.element_dofs.ravel(), fe.ravel(), minlength=sp_.n_dofs)
         return Contribution(internal=internal, blocks=[Blocks(sp_.element_dofs, ke)])
 
+    def energy(self, u: np.ndarray, t: float) -> float | None:
+        r""":math:`\int_{\Omega_0}\psi\,dV` (``None`` for the mixed formulation or laws without an energy)."""
+        if self.space.formulation != "u":
+            return None
+        F = self.deformation_gradient(u)
+        if not np.all(determinant(F) > 0.0):
+            return float("inf")
+        W = self.materials.energy_density(F)
+        return None if W is None else float(np.sum(W.T * self.space.dx))
+
     def _generic(self, F: np.ndarray, p: np.ndarray | None, tangent: bool):
         """P, element forces and stiffness through the laws' own ``pk1_and_tangent`` (any material)."""
         sp_ = self.space

@@ -11,11 +11,13 @@ state and the increment :math:`\Delta u_D` of the prescribed displacements it so
 then iterates :math:`K_{ff}(u^k)\,\Delta u_f = -R_f(u^k, t_{n+1})`. The tangent at :math:`u_n`
 is the one assembled at the last accepted iterate of the previous step (load-dependent terms
 re-evaluated). A step :math:`u^{k+1} = u^k + \alpha\,\Delta u` is accepted for the largest
-:math:`\alpha \in \{1, \tfrac12, \dots\}` that keeps :math:`J > 0` and does not increase
+:math:`\alpha \in \{c, \tfrac c2, \dots\}` that keeps :math:`J > 0` and does not increase
 :math:`\lVert R_f\rVert` (backtracking line search; in the predictor iteration the reference is the larger of
 the linearised residual and the true residual at :math:`u_n` with the new prescribed values, which is what a
 vanishing step length tends to: a slack cable that a prescribed motion pulls taut has a large true residual
-that the tangent at :math:`u_n` does not see). Convergence: relative residual
+that the tangent at :math:`u_n` does not see). The cap :math:`c \le 1` is the terms' own
+(:meth:`~skvalve.fem.problem.Problem.step_fraction`: a barrier's collision-free step, so no iterate passes through
+contact); a load step whose prescribed motion alone is not collision-free is cut back. Convergence: relative residual
 
 .. math::
 
@@ -166,6 +168,10 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
         prescribed[fixed] = new_values - old_values
         rhs = residual + problem.apply(tangent, prescribed)
         u[fixed] = new_values
+    if t_new != t_old and problem.step_fraction(u_old, t_old, u, t_new) < 1.0:
+        # the prescribed motion alone (supports, kinematic obstacles) would carry a surface through another: a
+        # shorter load step, not a shorter Newton step, is what can avoid it
+        raise _StepFailed(f"the prescribed motion from load factor {t_old:.6g} to {t_new:.6g} is not collision-free")
     if free.size == 0:  # every dof prescribed: the state is known, the residual gives the reactions
         residual, tangent = problem.assemble(u, t_new, tangent=True, step=step)
         return u, residual, [], tangent
@@ -194,6 +200,8 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
         energy0 = energy if energy0 is None else energy0
         largest = _largest_nodal(problem, du)
         alpha = 1.0 if opts.max_increment is None or largest <= opts.max_increment else opts.max_increment / largest
+        cap = problem.step_fraction(u, t_new, u + alpha * du, t_new)  # e.g. a barrier's collision-free step
+        alpha *= cap
         first_length, accepted = alpha, None
         shortest = alpha * 2.0 ** -opts.max_line_search * 1.5
         baseline = norm
@@ -368,6 +376,7 @@ def solve(problem: Problem, steps=10, *, rtol: float = 1e-8, atol: float = 0.0, 
             was_cut = failures > 0 or increment < _nominal(factors, target_index, t0) * (1 - 1e-12)
             failures = 0
             problem.commit()
+            problem.check_state(u_new, t_new)
             u, t = u_new, t_new
             cached = tangent
             result.append(t, u, residual, history)

@@ -225,12 +225,13 @@ class Problem:
         self.internal_forces, self.external_forces = internal, external
         return internal - external, Tangent(contributions)
 
-    def tangent_matrix(self, tangent: Tangent, blocks=None, matrix=None) -> sp.csr_matrix:
+    def tangent_matrix(self, tangent: Tangent, blocks=None, matrix=None, projected: bool = False) -> sp.csr_matrix:
         """Free-dof tangent K_ff from the contributions of :meth:`assemble`.
 
         ``blocks(term, matrices) -> matrices`` and ``matrix(term, sparse) -> sparse``, when given, replace each term's
         element blocks and extra matrix before they are added (e.g. their symmetric parts, or blocks projected onto
-        positive semidefinite ones: :func:`skvalve.fem.trust_region.step_matrix`).
+        positive semidefinite ones: :func:`skvalve.fem.trust_region.step_matrix`). ``projected``: a term's extra
+        matrix is replaced by its own PSD projection where it gives one (``Contribution.projected_matrix``).
         """
         pat = self.pattern
         data = np.zeros(pat.indices.size)
@@ -243,7 +244,10 @@ class Problem:
                     matrices = block.matrices if blocks is None else blocks(term, block.matrices)
                     scatter_add(np.ascontiguousarray(matrices), pos, data)
             if contribution.matrix is not None:
-                whole = contribution.matrix if matrix is None else matrix(term, contribution.matrix)
+                own = contribution.matrix
+                if projected and contribution.projected_matrix is not None:
+                    own = contribution.projected_matrix
+                whole = own if matrix is None else matrix(term, own)
                 part = sp.csr_matrix(whole)[pat.free][:, pat.free]
                 extra = part if extra is None else extra + part
         nfree = pat.free.size
@@ -262,6 +266,39 @@ class Problem:
             if contribution.matrix is not None:
                 out += contribution.matrix @ vector
         return out
+
+    # ------------------------------------------------------- steps and energy
+    def step_fraction(self, u0: np.ndarray, t0: float, u1: np.ndarray, t1: float) -> float:
+        """The smallest of the terms' :meth:`~skvalve.fem.terms.Term.step_fraction` for the straight move from
+        ``(u0, t0)`` to ``(u1, t1)``: the share of it that every term allows (1 when none limits steps)."""
+        fraction = 1.0
+        for term in self.terms:
+            limit = getattr(term, "step_fraction", None)
+            if limit is not None:
+                value = float(limit(u0, t0, u1, t1))
+                if not 0.0 < value <= 1.0:
+                    raise ValueError(f"term {term.name!r}: step_fraction must lie in (0, 1]; got {value!r}")
+                fraction = min(fraction, value)
+        return fraction
+
+    def check_state(self, u: np.ndarray, t: float) -> None:
+        """Let every term vet an accepted state (:meth:`~skvalve.fem.terms.Term.check_state`)."""
+        for term in self.terms:
+            check = getattr(term, "check_state", None)
+            if check is not None:
+                check(u, t)
+
+    def energy(self, u: np.ndarray, t: float) -> float | None:
+        r"""The total potential :math:`\Pi(u, t) = \sum_k \Pi_k`, or ``None`` when a term has none (a follower
+        pressure on an open surface, a term without :meth:`~skvalve.fem.terms.Term.energy`)."""
+        total = 0.0
+        for term in self.terms:
+            getter = getattr(term, "energy", None)
+            value = None if getter is None else getter(u, t)
+            if value is None:
+                return None
+            total += float(value)
+        return total
 
     # ------------------------------------------------------------------ state
     def commit(self) -> None:

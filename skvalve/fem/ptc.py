@@ -117,7 +117,7 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
     weight get no damping. ``edges``: (m, 2) node pairs (element edges, cables) watched by ``max_strain_increment``,
     ``rest_lengths`` the lengths from which each carries tension (default: the reference lengths; for a cable, its
     rest length). ``limit``: ``limit(u, du) -> f`` in (0, 1], the fraction of a pseudo-step's increment that may be
-    taken (e.g. :func:`~skvalve.fem.contact_clearance.clearance_fraction`); a step with ``f < 1`` is rejected and
+    taken (e.g. :func:`~skvalve.fem.contact.clearance.clearance_fraction`); a step with ``f < 1`` is rejected and
     ``dtau`` cut to ``max(0.1, 0.8 f)`` of itself (a pseudo-step's increment shrinks about as ``dtau``).
     Returns a :class:`PseudoTransientResult` with ``converged`` set; raises
     :class:`~skvalve.fem.errors.ConvergenceError` / :class:`~skvalve.fem.errors.NonPositiveJacobianError` when the
@@ -200,6 +200,7 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
                 dtau *= factor
                 continue
             problem.commit()
+            problem.check_state(trial, t_new)
             if opts.local_damping > 1.0:  # boosts fade: a node damped for one hard step must not stay frozen
                 np.maximum(1.0, boost * opts.local_decay, out=boost)
             previous = norm
@@ -291,6 +292,10 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
         fraction = _limited(limit, u, trial + du - u, "pseudo-transient")  # with the prescribed increments
         if fraction < 1.0:
             raise _Rejected(f"the step limit allows {fraction:.3g} of the increment", max(0.1, 0.8 * fraction))
+    fraction = problem.step_fraction(u, t_old, trial + du, t_new)  # e.g. a barrier's collision-free step
+    if fraction < 1.0:
+        raise _Rejected(f"term step limit (collision-free share) {fraction:.3g} of the increment",
+                        max(0.1, 0.8 * fraction))
     trial[free] += du_free
     if edges is not None and opts.max_strain_increment is not None and edges[0].size:
         changes = _stretch_changes(edges[2], u, trial, edges[0], edges[1])
@@ -325,6 +330,19 @@ def _limited(limit, u: np.ndarray, p: np.ndarray, solver: str) -> float:
     if not 0.0 < fraction <= 1.0:
         raise ValueError(f"{solver}: the step limit must return a fraction in (0, 1]; got {fraction!r}")
     return fraction
+
+
+def with_step_fraction(problem: Problem, t: float, limit=None):
+    """``limit(u, p)`` combined with the problem's own :meth:`~skvalve.fem.problem.Problem.step_fraction` at the held
+    load factor ``t`` (a barrier's collision-free step): the smaller of the two."""
+
+    def combined(u: np.ndarray, p: np.ndarray) -> float:
+        fraction = problem.step_fraction(u, t, u + p, t)
+        if limit is not None:
+            fraction = min(fraction, _limited(limit, u, p, "step limit"))
+        return fraction
+
+    return combined
 
 
 def _carriers(residual: np.ndarray, free: np.ndarray, space, share: float = 0.9, most: int = 1000) -> np.ndarray:

@@ -13,6 +13,12 @@ blocks on a connectivity fixed for the problem's life (the sparsity pattern is b
 :meth:`Term.connectivity`), plus an optional sparse matrix for connectivity that changes (contact).
 Terms holding state (warm-started RVEs, active contact sets) accept it in :meth:`Term.commit` after
 a converged load step and restore it in :meth:`Term.rewind` after a failed attempt.
+
+Three optional hooks serve contact that must never pass through (:mod:`skvalve.fem.contact.ipc`) and steps solved as
+minimisations (:mod:`skvalve.fem.incremental`): :meth:`Term.step_fraction` caps a trial step (every solver calls it
+before it evaluates a trial state), :meth:`Term.check_state` vets an accepted state (e.g. no intersection, in debug
+runs and tests), and :meth:`Term.energy` gives the term's potential :math:`\Pi_k` with
+:math:`\partial\Pi_k/\partial u = f^\text{int}_k - f^\text{ext}_k`, or ``None`` where the term is not conservative.
 """
 
 from __future__ import annotations
@@ -49,12 +55,15 @@ class Contribution:
     internal, external : (n_dofs,) force vectors, or None for zero.
     blocks : tangent blocks in the order of :meth:`Term.connectivity`.
     matrix : extra tangent on all dofs (n_dofs, n_dofs) for connectivity that changes.
+    projected_matrix : the term's own positive semidefinite projection of ``matrix`` (e.g. per contact stencil), for
+        projected Newton steps (:meth:`~skvalve.fem.problem.Problem.tangent_matrix` ``projected=True``).
     """
 
     internal: np.ndarray | None = None
     external: np.ndarray | None = None
     blocks: list[Blocks] = field(default_factory=list)
     matrix: sp.spmatrix | None = None
+    projected_matrix: sp.spmatrix | None = None
 
     def residual(self, n_dofs: int) -> np.ndarray:
         """This term's residual ``internal - external`` on all ``n_dofs`` dofs (zeros where it adds nothing)."""
@@ -92,6 +101,19 @@ class Term:
 
     def commit(self) -> None:
         """Accept the current (converged) state."""
+
+    def step_fraction(self, u0: np.ndarray, t0: float, u1: np.ndarray, t1: float) -> float:
+        """The fraction in (0, 1] of the straight move from state ``(u0, t0)`` to ``(u1, t1)`` that may be taken
+        (1: all of it). A contact barrier returns its collision-free step (continuous collision detection)."""
+        return 1.0
+
+    def check_state(self, u: np.ndarray, t: float) -> None:
+        """Raise when ``u`` at load factor ``t`` is not an admissible accepted state (called by the solvers after
+        each accepted state; a no-op unless a term checks something, e.g. intersections in a debug run)."""
+
+    def energy(self, u: np.ndarray, t: float) -> float | None:
+        """The term's potential at ``u`` (its gradient is the residual), or ``None`` when it has none."""
+        return None
 
     def rewind(self) -> None:
         """Return to the last committed state (after a failed attempt)."""

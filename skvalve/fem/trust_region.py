@@ -57,7 +57,7 @@ from . import linsolve
 from .errors import ConvergenceError, NonPositiveJacobianError
 from .newton import reference_force
 from .problem import Problem, Tangent
-from .ptc import _checked_edges, _limited, _stretch_changes
+from .ptc import _checked_edges, _limited, _stretch_changes, with_step_fraction
 from .trust_steps import (
     FIT_ABOVE,
     factorize_counted,
@@ -273,7 +273,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
     chordae branch points brought to equilibrium with the rest held); its energy change is added to the step's.
 
     ``limit``: ``limit(u, p) -> f`` in (0, 1], the fraction of a step ``p`` (already held to the radius) that may be
-    taken (e.g. :func:`~skvalve.fem.contact_clearance.clearance_fraction`: no node carried through a contact sheet);
+    taken (e.g. :func:`~skvalve.fem.contact.clearance.clearance_fraction`: no node carried through a contact sheet);
     it applies to Newton tries too.
 
     ``edges``/``rest_lengths`` as in :func:`~skvalve.fem.ptc.pseudo_transient`. Returns a :class:`TrustRegionResult`
@@ -292,6 +292,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
     if edges is not None:
         edges = _checked_edges(problem, edges, rest_lengths)
     problem.check_supports()
+    limit = with_step_fraction(problem, t, limit)  # the terms' own caps (a barrier's collision-free step) too
     pattern = problem.pattern
     fixed, free = pattern.fixed, pattern.free
     _, values = problem.constrained(t)
@@ -452,6 +453,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             local *= opts.local_decay
             local[local < opts.min_shift] = 0.0
             u, residual, tangent = u + p, trial_residual, trial_tangent
+            problem.check_state(u, t)
             if relax is not None:
                 clock = time.perf_counter()
                 relaxed, inner = relax(u, t)

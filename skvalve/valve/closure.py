@@ -76,7 +76,7 @@ class ClosureOptions:
     across triangle edges and has no search memory (:class:`~skvalve.fem.contact.SurfaceContact` ``blend``).
     contact_barrier : ``None`` for the penalty alone; else the overlap (a fraction of the search depth) from which a log
     barrier adds pressure that grows without bound towards the clearance limit's floor
-    (:class:`~skvalve.fem.contact.SurfaceContact` ``barrier``, :mod:`~skvalve.fem.contact_laws`).
+    (:class:`~skvalve.fem.contact.SurfaceContact` ``barrier``, :mod:`~skvalve.fem.contact.laws`).
     contact_depth : the contact's search depth g_max (mm; ``SurfaceContact`` ``max_penetration``): deeper
     passes are ignored and the clearance limit keeps steps to three quarters of it. ``None``: a quarter of the
     thinnest stack on extruded shells (their two skins a thickness apart must not pair), the mean face edge on bricks.

@@ -1,6 +1,6 @@
 r"""Lift nodes parked deep inside another sheet back towards it, a repair of a relaxation's state.
 
-The blended penalty fades out past :math:`0.8\,g_\max` (:mod:`~skvalve.fem.contact_blend`): there its energy falls
+The blended penalty fades out past :math:`0.8\,g_\max` (:mod:`~skvalve.fem.contact.blend`): there its energy falls
 with depth, so a node that a long relaxation carried that deep is pushed on rather than back, and the relaxation
 stalls with the node parked half-way through the other leaflet (on the 1.0 diseased valve: 20-odd nodes, a held
 relative residual stuck near 1e-4 for four sessions). :func:`lift_parked_nodes` moves each node whose overlap
@@ -39,7 +39,7 @@ import numpy as np
 import skfem
 
 from ..fem.contact import SurfaceContact
-from ..fem.contact_geometry import plane_gap
+from ..fem.contact.geometry import plane_gap
 from ..fem.errors import NonPositiveJacobianError
 from ..fem.problem import Problem
 from .closure import ClosureSetup

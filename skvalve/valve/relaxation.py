@@ -16,7 +16,7 @@ from functools import partial
 import numpy as np
 
 from ..fem.block_relaxation import BlockRelaxation
-from ..fem.contact_clearance import clearance_fraction
+from ..fem.contact.clearance import clearance_fraction
 from ..fem.damping import undamped_residual
 from ..fem.errors import ConvergenceError
 from ..fem.ptc import PseudoTransientOptions, pseudo_transient
@@ -93,7 +93,7 @@ def relax_closure(setup: ClosureSetup, end: float,
     the one before ended (:func:`held_stages`: an earlier stage hands on when it stalls,
     :attr:`~skvalve.fem.trust_region.TrustRegionOptions.stall_fraction`, or passes its ``max_steps``; a converged
     stage ends the run). Ψtc's and the trust region's steps are both limited by the
-    contact clearance (:func:`~skvalve.fem.contact_clearance.clearance_fraction`). Never raises for a failed run:
+    contact clearance (:func:`~skvalve.fem.contact.clearance.clearance_fraction`). Never raises for a failed run:
     the error and the kept state are recorded (the last accepted one; after Ψtc gave up at the held load, the held
     state with the smallest residual).
     """
@@ -218,7 +218,7 @@ def held_options(setup: ClosureSetup, **overrides) -> TrustRegionOptions:
     ``HELD_PROJECT`` says, a step longer than the radius shortened by a uniform shift fitted to it (``HELD_FIT_RADIUS``,
     ``HELD_SHIFT_SCALING``), the contact's indefinite blocks shifted locally (``HELD_SHIFT_TERMS``), and ``overrides``
     (e.g. ``rtol``, ``atol``). :func:`relax_closure` also limits each step by the contact clearance
-    (:func:`~skvalve.fem.contact_clearance.clearance_fraction`): a penalty energy ignores a node past the search depth,
+    (:func:`~skvalve.fem.contact.clearance.clearance_fraction`): a penalty energy ignores a node past the search depth,
     so a step that moved a node further than that relative to a nearby sheet could carry it through unseen."""
     depth = setup.contact.max_penetration
     return TrustRegionOptions(**{"radius": 0.25 * depth, "max_radius": max(depth, HELD_MAX_RADIUS),

@@ -18,7 +18,7 @@ r"""Contact pressure laws :math:`p(h)` of an overlap :math:`h \ge 0` and their e
   from the floor instead of from touching, :math:`C^2` at :math:`h_s` (value, slope and curvature vanish there).
   Its pressure is :math:`\varepsilon(2(r-\hat r)\ln(r/\hat r) + (r-\hat r)^2/r) \approx \varepsilon\hat r^2/r` near the
   floor, so a force that presses a node into a sheet is met before the node reaches the floor. The floor lies just
-  past the clearance limit's (:mod:`~skvalve.fem.contact_clearance`), which no guarded step crosses. Past the cutoff
+  past the clearance limit's (:mod:`~skvalve.fem.contact.clearance`), which no guarded step crosses. Past the cutoff
   :math:`r_c = 10^{-2}\hat r` (about :math:`100\,\varepsilon\hat r` of pressure) the pressure falls smoothly to zero by
   the start of the deep fade (``saturate``) and the energy stays at the value it has there: finite at every state,
   never a NaN, and bounded, for the pairs the clearance limit does not guard (already that deep when the contact
@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .contact_geometry import smooth_step
+from .geometry import smooth_step
 
 __all__ = ["BARRIER_CUTOFF", "depth_barrier", "rounded_penalty"]
 

@@ -11,7 +11,7 @@ pair :math:`j` (node :math:`s`, triangle :math:`T`) gets a weight
     \ell_i = \begin{cases} -\beta & \text{edge opposite } i \text{ shared with a neighbour} \\
     -2\beta & \text{free edge} \end{cases}
 
-with :math:`\lambda_i` the barycentric coordinates of the node's projection (:mod:`~skvalve.fem.contact_geometry`),
+with :math:`\lambda_i` the barycentric coordinates of the node's projection (:mod:`~skvalve.fem.contact.geometry`),
 :math:`S` the :math:`C^2` smooth step and :math:`\beta` the ``blend`` band: across a shared edge of two coplanar
 triangles of equal height the shares sum to one (:math:`S(t)+S(1-t)=1`), and past a free edge the surface is
 extended by :math:`2\beta` as the closest-triangle band does. :math:`\chi(g)` fades a pair in over
@@ -47,7 +47,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from .contact_geometry import smooth_step
+from .geometry import smooth_step
 
 __all__ = ["free_edges", "pair_weights", "sheets", "weighted_mean_energy", "DEEP_FADE", "BARRIER_FLOOR",
            "NORMALISATION_DELTA"]

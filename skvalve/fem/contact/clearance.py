@@ -2,14 +2,14 @@ r"""How far a step may carry a contact surface before a node could pass through 
 
 A penalty energy that ignores overlaps past the search depth :math:`g_\max` lets a long step carry a node through a
 sheet unseen; worse, the blended penalty fades out over :math:`0.8\,g_\max < h < g_\max`
-(:mod:`~skvalve.fem.contact_blend`), where its energy *falls* with depth, so a node that reached the fade is pushed on
+(:mod:`~skvalve.fem.contact.blend`), where its energy *falls* with depth, so a node that reached the fade is pushed on
 through (the 1.0 valve's search depth, 0.50 mm, is more than its two-layer leaflets' thickness, 0.39 mm). Capping
 every node's motion at :math:`g_\max` prevents that, but it also holds back the parts of a structure that swing or
 slide together. This limit looks at what matters, pair by pair: for a node :math:`i` of the surface and a triangle
 :math:`T` it may contact (not a topological neighbour, not excluded by reference distance: the pairs the contact
 search itself keeps) that the energy counts as facing (:meth:`~skvalve.fem.contact.SurfaceContact.facing`) and
 with the node no deeper than :math:`\tfrac34 g_\max` below the triangle's plane, the gap :math:`g(f)`
-(:mod:`~skvalve.fem.contact_geometry`) is followed along the step :math:`f p`, and wherever the node's projection lies
+(:mod:`~skvalve.fem.contact.geometry`) is followed along the step :math:`f p`, and wherever the node's projection lies
 where the pair's band weight is at least ½ (:meth:`~skvalve.fem.contact.SurfaceContact.band_lower` plus
 :math:`\beta`: barycentric coordinates :math:`\ge -\beta` opposite a free edge, :math:`\ge 0` opposite a shared one,
 past which the node lies over the neighbour, whose pair guards it) it must stay
@@ -23,7 +23,7 @@ three quarters of the depth, short of the fade-out. So no step carries a node fr
 fade-out, and the step's energy test sees the barrier. Pairs already at 0.74 of the depth or deeper are let go: a node
 that the forces hold at its floor despite the full penalty would otherwise stop every step (this happened on the 1.1
 valve), and from there on only the energy test stands in its way. With the contact's depth barrier
-(``SurfaceContact(barrier=...)``, :func:`~skvalve.fem.contact_laws.depth_barrier`) the energy itself grows without
+(``SurfaceContact(barrier=...)``, :func:`~skvalve.fem.contact.laws.depth_barrier`) the energy itself grows without
 bound towards this floor, so the forces that press a node in are met before it gets there.
 
 Earlier rules each stopped a valve run at one node held at its floor: half the depth, with nodes already deeper held
@@ -52,9 +52,9 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .contact import SurfaceContact
-from .contact_blend import BARRIER_FLOOR
-from .contact_geometry import barycentric, plane_gap
+from .blend import BARRIER_FLOOR
+from .geometry import barycentric, plane_gap
+from .penalty import SurfaceContact
 
 __all__ = ["clearance_fraction"]
 

@@ -38,7 +38,7 @@ topological neighbourhood (``exclude_rings`` rings of faces). The energy and its
 with the overlap :math:`h = -g`, :math:`A_s` the node's reference tributary area and :math:`p` the contact
 pressure: a penalty :math:`\varepsilon` whose first :math:`h_0` is rounded (``smoothing``) so that force and
 stiffness are continuous when a pair switches on (a kink there makes Newton chatter between active sets;
-:mod:`~skvalve.fem.contact_laws`, which also has the optional depth barrier). With
+:mod:`~skvalve.fem.contact.laws`, which also has the optional depth barrier). With
 :math:`d = x_s - x_1`, :math:`a = x_2 - x_1`, :math:`b = x_3 - x_1`, :math:`\mu = |m|`,
 :math:`P = I - n\otimes n` and :math:`w = P d/\mu`:
 
@@ -55,7 +55,7 @@ and :math:`\partial^2 g/\partial a_i\partial b_j = \partial^2 g/\partial m^2` ma
 assembly (the tangent is exact for a fixed set), so the tangent is returned as a sparse matrix on all dofs.
 
 With ``blend`` > 0 the closest-triangle rule (its dead zones over concave creases, its search memory) gives way
-to blended pairs (:mod:`skvalve.fem.contact_blend`): every nearby triangle carries a smooth share of the node's
+to blended pairs (:mod:`skvalve.fem.contact.blend`): every nearby triangle carries a smooth share of the node's
 penalty energy :math:`\psi(h)` (:math:`\psi' = p`), whose gradient and Hessian are the force and tangent.
 
 Contact pressure (Abaqus CPRESS/CAREA): the nodal traction is the normal component of the total contact
@@ -70,8 +70,10 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .contact_blend import BARRIER_FLOOR, DEEP_FADE, free_edges, pair_weights, sheets, weighted_mean_energy
-from .contact_geometry import (
+from ..space import Space
+from ..terms import Contribution, Term
+from .blend import BARRIER_FLOOR, DEEP_FADE, free_edges, pair_weights, sheets, weighted_mean_energy
+from .geometry import (
     barycentric,
     barycentric_derivatives,
     gap_derivatives,
@@ -79,84 +81,13 @@ from .contact_geometry import (
     plane_gap,
     smooth_step,
 )
-from .contact_laws import depth_barrier, rounded_penalty
-from .space import Space
-from .terms import Contribution, Term
+from .laws import depth_barrier, rounded_penalty
+from .surface import ContactSurface, oriented_quads
 
 #: Blended contact: the facing factor rises from 0 at -n_s.n = opposing to 1 this much above it.
 FACING_BAND = 0.2
 
 __all__ = ["ContactSurface", "ActivePairs", "SurfaceContact", "gap_derivatives", "oriented_quads"]
-
-
-def oriented_quads(X: np.ndarray, quads: np.ndarray, inside: np.ndarray) -> np.ndarray:
-    """Quads (n, 4) in cyclic order with the normal pointing away from the points ``inside`` (n, 3).
-
-    ``X`` (n_nodes, 3) reference coordinates; each quad's nodes are sorted by angle about its centroid in
-    its best-fit plane (so any input order works), then reversed where the normal faces ``inside``.
-    """
-    quads = np.asarray(quads, dtype=np.int64)
-    P = X[quads]  # (n, 4, 3)
-    centre = P.mean(axis=1, keepdims=True)
-    rel = P - centre
-    normal = np.cross(rel[:, 0], rel[:, 1]) + np.cross(rel[:, 1], rel[:, 2]) + np.cross(rel[:, 2], rel[:, 3]) \
-        + np.cross(rel[:, 3], rel[:, 0]) + np.cross(rel[:, 0], rel[:, 2])
-    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
-    e1 = rel[:, 0] / np.linalg.norm(rel[:, 0], axis=1, keepdims=True)
-    e2 = np.cross(normal, e1)
-    angle = np.arctan2(np.einsum("nkj,nj->nk", rel, e2), np.einsum("nkj,nj->nk", rel, e1))
-    ordered = np.take_along_axis(quads, np.argsort(angle, axis=1), axis=1)
-    Q = X[ordered]
-    area_vector = np.cross(Q[:, 2] - Q[:, 0], Q[:, 3] - Q[:, 1])
-    flip = np.einsum("ij,ij->i", area_vector, Q.mean(axis=1) - np.asarray(inside, dtype=float)) < 0.0
-    ordered[flip] = ordered[flip][:, ::-1]
-    return ordered
-
-
-@dataclass
-class ContactSurface:
-    """A surface of quadrilateral faces (cyclic, outward) split into triangles.
-
-    Attributes
-    ----------
-    quads : (n_faces, 4) scalar node indices, cyclic, normal outward.
-    triangles : (2 n_faces, 3) the triangles (face k gives triangles 2k and 2k+1).
-    nodes : (n_nodes,) the surface's nodes, sorted.
-    nodal_area : (n_nodes,) reference tributary area of each of ``nodes`` (a quarter of each adjacent face).
-    """
-
-    quads: np.ndarray
-    triangles: np.ndarray
-    nodes: np.ndarray
-    nodal_area: np.ndarray
-
-    @classmethod
-    def from_quads(cls, X: np.ndarray, quads: np.ndarray, inside: np.ndarray | None = None) -> ContactSurface:
-        """From reference coordinates ``X`` (n, 3) and faces (cyclic unless ``inside``: points behind each face)."""
-        X = np.asarray(X, dtype=float)
-        quads = np.asarray(quads, dtype=np.int64)
-        if quads.ndim != 2 or quads.shape[1] != 4 or quads.shape[0] == 0:
-            raise ValueError(f"contact surface: faces must have shape (n > 0, 4); got {quads.shape}")
-        if quads.min() < 0 or quads.max() >= X.shape[0]:
-            raise ValueError(f"contact surface: face node indices must lie in 0..{X.shape[0] - 1}")
-        if inside is not None:
-            quads = oriented_quads(X, quads, inside)
-        triangles = np.stack([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]], axis=1).reshape(-1, 3)
-        Q = X[quads]
-        area = 0.5 * np.linalg.norm(np.cross(Q[:, 2] - Q[:, 0], Q[:, 3] - Q[:, 1]), axis=1)
-        if not np.all(area > 0.0):
-            raise ValueError(f"contact surface: degenerate face(s) {np.flatnonzero(~(area > 0))[:10].tolist()}")
-        nodes, inverse = np.unique(quads, return_inverse=True)
-        nodal_area = np.bincount(inverse.ravel(), np.repeat(area / 4.0, 4), minlength=nodes.size)
-        return cls(quads, triangles, nodes, nodal_area)
-
-    @classmethod
-    def from_facets(cls, mesh, facets: np.ndarray) -> ContactSurface:
-        """From boundary facets of a scikit-fem hex mesh (oriented away from their element)."""
-        facets = np.asarray(facets, dtype=np.int64).ravel()
-        owner = mesh.f2t[0, facets]
-        inside = mesh.p[:, mesh.t[:, owner]].mean(axis=1).T
-        return cls.from_quads(mesh.p.T, mesh.facets[:, facets].T, inside)
 
 
 @dataclass
@@ -196,12 +127,12 @@ class SurfaceContact(Term):
     exclude_within : a node never contacts a triangle whose reference centroid lies closer than this (self-contact of
         a thick surface: across a free edge's rim the two skins are a thickness apart and, bent, seem to overlap).
     blend : 0 (default) for the closest-triangle rule; a band beta in (0, 0.5] for blended contact
-        (:mod:`skvalve.fem.contact_blend`: every triangle near a node takes a smooth share, no search memory, energy
+        (:mod:`skvalve.fem.contact.blend`: every triangle near a node takes a smooth share, no search memory, energy
         continuous with its gradient across triangle edges; ``tolerance`` is then unused).
     barrier : ``None`` (default) for the penalty alone; a fraction :math:`h_s/g_\\text{max}` below
         ``BARRIER_FLOOR`` (0.76) from which a log barrier adds pressure that grows without bound as the overlap nears
         ``BARRIER_FLOOR`` :math:`g_\\text{max}`, just past the floor of the clearance limit (0.75), and fades past
-        it by the deep fade (:func:`~skvalve.fem.contact_laws.depth_barrier`).
+        it by the deep fade (:func:`~skvalve.fem.contact.laws.depth_barrier`).
     """
 
     name = "contact"
@@ -252,7 +183,7 @@ class SurfaceContact(Term):
 
     def may_contact(self, node: np.ndarray, triangle: np.ndarray) -> np.ndarray:
         """(n,) bool: the node-triangle pairs that are not excluded (topological neighbours, or closer than
-        ``exclude_within`` in the reference); the search and :mod:`~skvalve.fem.contact_clearance` both use it."""
+        ``exclude_within`` in the reference); the search and :mod:`~skvalve.fem.contact.clearance` both use it."""
         keys = node * self.surface.triangles.shape[0] + triangle
         if self._excluded.size:  # sorted unique keys: a binary search (np.isin re-sorts them on every call)
             at = np.minimum(np.searchsorted(self._excluded, keys), self._excluded.size - 1)
@@ -314,7 +245,7 @@ class SurfaceContact(Term):
             + self.max_penetration
 
     def _blended_candidates(self, x, node, triangle, gap, corners) -> ActivePairs:
-        r"""Every pair whose blended share is positive (:mod:`~skvalve.fem.contact_blend`), with its facing factor
+        r"""Every pair whose blended share is positive (:mod:`~skvalve.fem.contact.blend`), with its facing factor
         :math:`S((-n_s\cdot n - c)/0.2)` taken at the last committed state (the current one before any commit:
         its tangent then leaves out the factor's change) (lagged: a node normal depends on the
         node's neighbours, outside the pair; frozen within a step, the factor leaves the energy a function of the
@@ -438,7 +369,7 @@ class SurfaceContact(Term):
         return Contribution(internal=internal, matrix=matrix)
 
     def _assemble_blended(self, pairs, corners, gap, penalty: float, dofs, tangent) -> Contribution:
-        """Blended contact (:mod:`skvalve.fem.contact_blend`) of the candidate pairs (some above their face)."""
+        """Blended contact (:mod:`skvalve.fem.contact.blend`) of the candidate pairs (some above their face)."""
         g, g_grad, g_hess = gap
         overlap = np.maximum(-g, 0.0)
         psi, pressure, stiffness = self.contact_law(overlap, penalty)
@@ -470,7 +401,7 @@ class SurfaceContact(Term):
 
     def contact_law(self, overlap: np.ndarray, penalty: float):
         """Energy per area psi(h), pressure p(h) = psi'(h) and dp/dh at overlaps ``h`` >= 0: the rounded penalty plus,
-        with ``barrier``, the depth barrier (:mod:`~skvalve.fem.contact_laws`)."""
+        with ``barrier``, the depth barrier (:mod:`~skvalve.fem.contact.laws`)."""
         energy, pressure, stiffness = rounded_penalty(overlap, penalty, self.smoothing)
         if self.barrier is None:
             return energy, pressure, stiffness

@@ -1,0 +1,358 @@
+r"""Incremental Potential Contact: a barrier that never lets surfaces pass through (ipctk).
+
+Choice and why
+--------------
+Contact by the IPC barrier of Li et al. (2020, *ACM Trans. Graph.* 39(4) 49) through the well-kept library
+``ipctk`` (MIT; collision sets, barrier derivatives with per-stencil PSD projection, exact continuous collision
+detection), not our own code: its guarantee -- no accepted state ever intersects -- needs exact CCD of
+point–triangle and edge–edge trajectories, which is hard to get right and is what ipctk does best. The penalty law of
+:mod:`skvalve.fem.contact.penalty` admits pass-through minima by construction (past its search depth a node feels no
+force); this one has none: the energy grows without bound as any distance goes to zero, and every solver caps its
+trial steps at the collision-free fraction (:meth:`IPCContact.step_fraction`, continuous collision detection times
+0.9), so iterates stay on the side they started.
+
+Formulation
+-----------
+The collision mesh is the body's boundary (hex faces split into triangles, :class:`~.surface.ContactSurface`) with any
+:class:`~.obstacles.Obstacle` surfaces (prescribed motion) and :class:`~.obstacles.Plane` s. For the set
+:math:`\mathcal C` of primitive pairs (point–triangle, edge–edge, point–plane and their degenerate cases) closer than
+:math:`\hat d`, the barrier potential is
+
+.. math::
+
+    B(x) = \kappa \sum_{k\in\mathcal C} w_k\, \frac{b(d_k^2(x))}{\hat d^{\,3}}, \qquad
+    b(s) = -(s - \hat d^2)^2 \ln\frac{s}{\hat d^2} \quad (0 < s < \hat d^2),
+
+with :math:`w_k` the pair's area weight (ipctk's area weighting: the vertex area for a point–plane pair) and the
+physical scaling :math:`\hat d^{-3}`, so that :math:`\kappa` is a **pressure** (force per area; kPa for N, mm and
+the valve's units): a vertex of area :math:`A` at distance :math:`d` from a plane carries the force
+:math:`A\,p(d)`, :math:`p(d) = -2d\,\kappa\,b'(d^2)/\hat d^3` (:func:`barrier_pressure`). :math:`\hat d` is a length
+(the range of the barrier: keep it below the smallest gap that must stay open at rest, e.g. a leaflet's thickness, and
+below the mesh size); :func:`stiffness_for_pressure` picks :math:`\kappa` so that a given pressure is carried at a
+given fraction of :math:`\hat d`, and :meth:`IPCContact.suggest_stiffness` is IPC's own rule
+(``initial_barrier_stiffness``: the stiffness that balances the elastic gradient). With ``adaptive`` the stiffness is
+doubled after a step whose smallest distance fell below :math:`10^{-9}` of the bounding box diagonal
+(``update_barrier_stiffness``), which changes the problem between steps; it is off by default.
+
+Pairs of body vertices closer than ``exclude_within`` in the reference never collide (ipctk ``make_sparse_filter``:
+the two skins of a thin shell across a free edge), nor do two obstacle vertices (``make_vertex_patches_filter``).
+
+Friction (optional, :class:`Friction`): the smoothed Coulomb potential of IPC, lagged: the normal forces and the
+tangent bases are those of the last committed state, and the sliding is the displacement of the collision vertices
+since then, mollified below the slip length :math:`\epsilon` (Li et al. 2020, Sect. 5; ipctk
+``TangentialCollisions``/``FrictionPotential``).
+
+Output: per-vertex contact pressure is the barrier force's magnitude over the vertex's area weight (a third of the
+reference area of its triangles, so that a vertex facing a plane reports exactly :math:`p(d)`); a
+face's pressure is the mean of its nodes', and the contact area (Abaqus CAREA) the current area of faces with positive
+pressure (both touching sides count).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import ipctk
+import numpy as np
+import scipy.sparse as sp
+from scipy.spatial import cKDTree
+
+from ..errors import SolverError
+from ..space import Space
+from ..terms import Contribution, Term
+from .obstacles import Obstacle, Plane
+from .surface import ContactSurface
+
+__all__ = ["IPCContact", "Friction", "IntersectionError", "barrier_pressure", "stiffness_for_pressure"]
+
+#: a capped step takes this share of the collision-free fraction (IPC's line search)
+STEP_SAFETY = 0.9
+#: the smallest fraction a term returns (a start state in touching contact would otherwise give 0)
+SMALLEST_FRACTION = 1e-12
+
+
+class IntersectionError(SolverError):
+    """An accepted state whose collision mesh intersects itself (a debug check, :meth:`IPCContact.check_state`)."""
+
+
+@dataclass(frozen=True)
+class Friction:
+    """Smoothed, lagged Coulomb friction: coefficient ``mu`` and slip length ``slip`` (below it, sticking is
+    a stiff spring; in length units)."""
+
+    mu: float
+    slip: float
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.mu) and self.mu >= 0.0):
+            raise ValueError(f"friction: mu must be finite and >= 0; got {self.mu!r}")
+        if not (np.isfinite(self.slip) and self.slip > 0.0):
+            raise ValueError(f"friction: slip must be a positive length; got {self.slip!r}")
+
+
+def barrier_pressure(distance, dhat: float, stiffness: float) -> np.ndarray:
+    r"""Pressure :math:`p(d) = -2d\,\kappa\,b'(d^2)/\hat d^3` of the area-weighted physical barrier at ``distance``
+    (0 at and beyond :math:`\hat d`): the force per area on a vertex facing a plane (module docstring)."""
+    d = np.asarray(distance, dtype=float)
+    s, sh = d * d, dhat * dhat
+    with np.errstate(divide="ignore", invalid="ignore"):
+        derivative = -2.0 * (s - sh) * np.log(s / sh) - (s - sh) ** 2 / s
+        p = -2.0 * d * stiffness * derivative / dhat ** 3
+    return np.where(d < dhat, p, 0.0)
+
+
+def stiffness_for_pressure(pressure: float, dhat: float, at: float = 0.5) -> float:
+    """The barrier stiffness :math:`\\kappa` (a pressure) carrying ``pressure`` at the distance ``at`` × ``dhat``."""
+    if not (0.0 < at < 1.0):
+        raise ValueError(f"stiffness_for_pressure: at must lie in (0, 1); got {at!r}")
+    if not (np.isfinite(pressure) and pressure > 0.0 and np.isfinite(dhat) and dhat > 0.0):
+        raise ValueError(f"stiffness_for_pressure: pressure and dhat must be positive; got {pressure!r}, {dhat!r}")
+    return float(pressure / barrier_pressure(at * dhat, dhat, 1.0))
+
+
+class IPCContact(Term):
+    r"""IPC barrier contact of a body's surface with itself, with moving obstacles and with planes.
+
+    Parameters
+    ----------
+    space : the 3D displacement :class:`~skvalve.fem.space.Space` (linear; surface nodes are its scalar dofs).
+    surface : the body's :class:`~.surface.ContactSurface` (default: every boundary facet of the mesh).
+    dhat : :math:`\hat d`, the barrier's range (length).
+    stiffness : :math:`\kappa`, a pressure (module docstring; :func:`stiffness_for_pressure`).
+    obstacles, planes : kinematic surfaces and fixed planes the body must not pass.
+    exclude_within : body vertices closer than this in the reference never collide with each other.
+    friction : optional :class:`Friction` (lagged).
+    check_intersections : after each accepted state, raise :class:`IntersectionError` if the surface intersects
+        (ipctk ``has_intersections``; costs a full check: for debug runs and tests).
+    adaptive : raise :math:`\kappa` as IPC does after steps that bring surfaces very close (off: a fixed problem).
+    self_contact : False to drop contact of the body with itself (obstacles and planes only).
+    """
+
+    name = "ipc contact"
+    symmetric = True
+
+    def __init__(self, space: Space, surface: ContactSurface | None = None, *, dhat: float, stiffness: float,
+                 obstacles: Sequence[Obstacle] = (), planes: Sequence[Plane] = (), exclude_within: float = 0.0,
+                 friction: Friction | None = None, check_intersections: bool = False, adaptive: bool = False,
+                 self_contact: bool = True) -> None:
+        if space.dim != 3 or space.order != 1:
+            raise ValueError("ipc contact: needs a linear 3D displacement space")
+        if not (np.isfinite(dhat) and dhat > 0.0):
+            raise ValueError(f"ipc contact: dhat must be a positive length; got {dhat!r}")
+        if not (np.isfinite(stiffness) and stiffness > 0.0):
+            raise ValueError(f"ipc contact: stiffness must be a positive pressure; got {stiffness!r}")
+        if not (np.isfinite(exclude_within) and exclude_within >= 0.0):
+            raise ValueError(f"ipc contact: exclude_within must be a length >= 0; got {exclude_within!r}")
+        mesh = space.mesh
+        if surface is None:
+            surface = ContactSurface.from_facets(mesh, mesh.boundary_facets())
+        if surface.nodes.max() >= space.n_scalar:
+            raise ValueError(f"ipc contact: surface node {surface.nodes.max()} beyond the space's {space.n_scalar}")
+        self.space, self.surface = space, surface
+        self.dhat, self.stiffness = float(dhat), float(stiffness)
+        self.obstacles, self.planes = list(obstacles), list(planes)
+        self.friction, self.check_intersections, self.adaptive = friction, bool(check_intersections), bool(adaptive)
+        self.X = mesh.p.T
+        self.nodes = surface.nodes
+        self.n_body = self.nodes.size
+        local = np.full(space.n_scalar, -1, dtype=np.int64)
+        local[self.nodes] = np.arange(self.n_body)
+        faces = [local[surface.triangles]]
+        rest = [self.X[self.nodes]]
+        offset = self.n_body
+        self._obstacle_rows = []
+        for obstacle in self.obstacles:
+            rest.append(obstacle.at(0.0))
+            faces.append(obstacle.triangles + offset)
+            self._obstacle_rows.append(slice(offset, offset + obstacle.vertices.shape[0]))
+            offset += obstacle.vertices.shape[0]
+        triangles = np.ascontiguousarray(np.concatenate(faces), dtype=np.int32)
+        edges = ipctk.edges(triangles)
+        self.rest = np.ascontiguousarray(np.concatenate(rest))
+        self.mesh = ipctk.CollisionMesh(self.rest, edges, triangles)
+        if self.planes:
+            self.mesh.planes = [ipctk.Hyperplane(plane.normal, plane.point) for plane in self.planes]
+        self.mesh.can_collide = self._filter(exclude_within, self_contact)
+        self.diagonal = float(ipctk.world_bbox_diagonal_length(self.rest))
+        self.barrier = ipctk.BarrierPotential(self.dhat, self.stiffness, True)
+        self.collisions = ipctk.NormalCollisions()
+        self.collisions.use_area_weighting = True
+        self.area = np.zeros(space.n_scalar)  # the barrier's area weights: a third of each adjacent triangle
+        self.area[self.nodes] = np.asarray(self.mesh.vertex_areas)[: self.n_body]
+        rows = (3 * self.nodes[:, None] + np.arange(3)).ravel()
+        self._select = sp.csr_matrix((np.ones(rows.size), (rows, np.arange(rows.size))),
+                                     shape=(space.n_dofs, 3 * self.rest.shape[0]))
+        self._friction_potential = None if friction is None else ipctk.FrictionPotential(friction.slip)
+        self._tangential = None
+        self._lagged = self.rest.copy()
+        self._committed_u = np.zeros(space.n_dofs)
+        self._committed_t = 0.0
+        self._last: tuple[np.ndarray, float] | None = None
+        self._previous_distance: float | None = None
+        self.max_stiffness = 1e3 * self.stiffness
+        self.last_force = np.zeros(space.n_dofs)
+        self.last_distance = np.inf
+        if ipctk.has_intersections(self.mesh, self.rest):
+            raise IntersectionError("ipc contact: the reference collision mesh intersects itself (check the surface "
+                                    "and the obstacles' positions at load factor 0)")
+
+    # ------------------------------------------------------------------ set-up
+    def _filter(self, exclude_within: float, self_contact: bool) -> ipctk.CollisionFilter:
+        """Obstacle vertices never collide with each other; body vertices closer than ``exclude_within`` in the
+        reference (and all body pairs without self-contact) neither."""
+        patches = np.arange(self.rest.shape[0], dtype=np.int32)
+        patches[self.n_body:] = self.n_body  # every obstacle vertex in one patch: no obstacle-obstacle pairs
+        if not self_contact:
+            patches[: self.n_body] = -1
+        allowed = ipctk.make_vertex_patches_filter(patches)
+        if exclude_within > 0.0 and self_contact:
+            pairs = cKDTree(self.rest[: self.n_body]).query_pairs(exclude_within, output_type="ndarray")
+            explicit = {(int(min(a, b)), int(max(a, b))): False for a, b in pairs}
+            allowed = allowed & ipctk.make_sparse_filter(explicit, True)
+        return allowed
+
+    def positions(self, u: np.ndarray, t: float) -> np.ndarray:
+        """Collision-mesh vertex positions (n, 3): the body's surface at ``u``, the obstacles at ``t``."""
+        V = self.rest.copy()
+        V[: self.n_body] += u[: self.space.n_u].reshape(-1, 3)[self.nodes]
+        for obstacle, rows in zip(self.obstacles, self._obstacle_rows, strict=True):
+            V[rows] = obstacle.at(t)
+        return V
+
+    def suggest_stiffness(self, elastic_gradient: np.ndarray, u: np.ndarray, t: float,
+                          average_mass: float = 1.0) -> tuple[float, float]:
+        """IPC's initial stiffness (ipctk ``initial_barrier_stiffness``) at state ``u``: the :math:`\\kappa` whose
+        barrier gradient balances ``elastic_gradient`` (n_dofs,: the other terms' residual), and its upper bound."""
+        V = self.positions(u, t)
+        self.collisions.build(self.mesh, V, self.dhat)
+        unit = ipctk.BarrierPotential(self.dhat, 1.0, True)
+        grad_barrier = unit.gradient(self.collisions, self.mesh, V)
+        grad_energy = self._select.T @ np.asarray(elastic_gradient, dtype=float)
+        return tuple(float(v) for v in ipctk.initial_barrier_stiffness(
+            self.diagonal, unit.barrier, self.dhat, average_mass, grad_energy, grad_barrier))
+
+    # ---------------------------------------------------------------- assembly
+    def assemble(self, u: np.ndarray, t: float, tangent: bool, step: int | None) -> Contribution:
+        V = self.positions(u, t)
+        self.collisions.build(self.mesh, V, self.dhat)
+        grad = self.barrier.gradient(self.collisions, self.mesh, V)
+        matrix = projected = None
+        if tangent:
+            H = self.barrier.hessian(self.collisions, self.mesh, V, ipctk.PSDProjectionMethod.NONE)
+            Hp = self.barrier.hessian(self.collisions, self.mesh, V, ipctk.PSDProjectionMethod.CLAMP)
+        if self._tangential is not None and len(self._tangential):
+            slip = V - self._lagged
+            grad = grad + self._friction_potential.gradient(self._tangential, self.mesh, slip)
+            if tangent:
+                Hf = self._friction_potential.hessian(self._tangential, self.mesh, slip,
+                                                      ipctk.PSDProjectionMethod.NONE)
+                H = H + Hf
+                Hp = Hp + self._friction_potential.hessian(self._tangential, self.mesh, slip,
+                                                           ipctk.PSDProjectionMethod.CLAMP)
+        internal = self._select @ grad
+        if tangent:
+            matrix = (self._select @ H @ self._select.T).tocsr()
+            projected = (self._select @ Hp @ self._select.T).tocsr()
+        self.last_force = internal
+        self._last = (np.array(u, copy=True), float(t))
+        return Contribution(internal=internal, matrix=matrix, projected_matrix=projected)
+
+    def energy(self, u: np.ndarray, t: float) -> float:
+        """:math:`B(x)` (plus the lagged friction potential)."""
+        V = self.positions(u, t)
+        self.collisions.build(self.mesh, V, self.dhat)
+        value = float(self.barrier(self.collisions, self.mesh, V))
+        if self._tangential is not None and len(self._tangential):
+            value += float(self._friction_potential(self._tangential, self.mesh, V - self._lagged))
+        return value
+
+    def minimum_distance(self, u: np.ndarray, t: float) -> float:
+        """The smallest distance between primitives that may collide, within :math:`\\hat d` (inf beyond it)."""
+        V = self.positions(u, t)
+        self.collisions.build(self.mesh, V, self.dhat)
+        if len(self.collisions) == 0:
+            return float("inf")
+        return float(np.sqrt(self.collisions.compute_minimum_distance(self.mesh, V)))
+
+    def active_pairs(self, u: np.ndarray, t: float) -> int:
+        """The number of primitive pairs within :math:`\\hat d` at ``u``, ``t``."""
+        V = self.positions(u, t)
+        self.collisions.build(self.mesh, V, self.dhat)
+        return len(self.collisions)
+
+    # ------------------------------------------------------------ step control
+    def step_fraction(self, u0: np.ndarray, t0: float, u1: np.ndarray, t1: float) -> float:
+        """0.9 of the collision-free share of the straight move (ipctk ``compute_collision_free_stepsize``), 1 when
+        the whole move is free."""
+        V0, V1 = self.positions(u0, t0), self.positions(u1, t1)
+        fraction = float(ipctk.compute_collision_free_stepsize(self.mesh, V0, V1))
+        return 1.0 if fraction >= 1.0 else max(STEP_SAFETY * fraction, SMALLEST_FRACTION)
+
+    def intersects(self, u: np.ndarray, t: float) -> bool:
+        """True when the collision mesh intersects itself at ``u``, ``t`` (ipctk ``has_intersections``)."""
+        return bool(ipctk.has_intersections(self.mesh, self.positions(u, t)))
+
+    def check_state(self, u: np.ndarray, t: float) -> None:
+        if self.check_intersections and self.intersects(u, t):
+            raise IntersectionError(f"ipc contact: the accepted state at load factor {t:.6g} intersects itself")
+
+    # ------------------------------------------------------------------- state
+    def commit(self) -> None:
+        """Accept the last assembled state: lag friction there, and (``adaptive``) update the stiffness."""
+        if self._last is None:
+            return
+        u, t = self._last
+        self._committed_u, self._committed_t = u, t
+        V = self.positions(u, t)
+        self.collisions.build(self.mesh, V, self.dhat)
+        distance = float(np.sqrt(self.collisions.compute_minimum_distance(self.mesh, V))) \
+            if len(self.collisions) else float("inf")
+        self.last_distance = distance
+        if self.adaptive and np.isfinite(distance):
+            previous = distance if self._previous_distance is None else self._previous_distance
+            kappa = float(ipctk.update_barrier_stiffness(previous ** 2, distance ** 2, self.max_stiffness,
+                                                         self.stiffness, self.diagonal))
+            if kappa != self.stiffness:
+                self.stiffness = kappa
+                self.barrier = ipctk.BarrierPotential(self.dhat, kappa, True)
+        self._previous_distance = distance if np.isfinite(distance) else None
+        if self.friction is not None:
+            self._lagged = V
+            self._tangential = ipctk.TangentialCollisions()
+            self._tangential.build(self.mesh, V, self.collisions, self.barrier, self.friction.mu)
+
+    def rewind(self) -> None:
+        self._last = (self._committed_u, self._committed_t)
+
+    def state(self) -> dict[str, np.ndarray]:
+        """The committed state: displacement and load factor of the lag, and the stiffness."""
+        return {"u": self._committed_u, "t": np.array(self._committed_t), "stiffness": np.array(self.stiffness)}
+
+    def restore(self, arrays: dict[str, np.ndarray]) -> None:
+        if not arrays:
+            return
+        self.stiffness = float(arrays["stiffness"])
+        self.barrier = ipctk.BarrierPotential(self.dhat, self.stiffness, True)
+        self._last = (np.asarray(arrays["u"], dtype=float), float(arrays["t"]))
+        self.commit()
+
+    # ------------------------------------------------------------------ output
+    def nodal_pressure(self, u: np.ndarray, t: float) -> np.ndarray:
+        """Contact pressure per node (n_scalar,): the barrier force's magnitude over the vertex's area weight."""
+        force = self.assemble(u, t, False, None).internal[: self.space.n_u].reshape(-1, 3)
+        pressure = np.zeros(self.space.n_scalar)
+        pressure[self.nodes] = np.linalg.norm(force[self.nodes], axis=1) / self.area[self.nodes]
+        return pressure
+
+    def face_pressure(self, u: np.ndarray, t: float) -> np.ndarray:
+        """Contact pressure per face of the surface (n_faces,): the mean of its nodes'."""
+        return self.nodal_pressure(u, t)[self.surface.quads].mean(axis=1)
+
+    def contact_area(self, u: np.ndarray, t: float, threshold: float = 0.0) -> float:
+        """Current area of the faces whose pressure exceeds ``threshold`` (CAREA; both touching sides count)."""
+        pressure = self.face_pressure(u, t)
+        x = self.X + u[: self.space.n_u].reshape(-1, 3)
+        Q = x[self.surface.quads]
+        area = 0.5 * np.linalg.norm(np.cross(Q[:, 2] - Q[:, 0], Q[:, 3] - Q[:, 1]), axis=1)
+        return float(area[pressure > threshold].sum())

@@ -1,0 +1,248 @@
+r"""Load steps solved as minimisations: the incremental potential, projected Newton and a collision-free line search.
+
+Each load step :math:`t_n \to t_{n+1}` minimises (Kane et al. 2000; Li et al. 2020, Sect. 4)
+
+.. math::
+
+    E(u) = \Pi(u, t_{n+1}) + \frac{1}{2h^2}\,(u - \tilde u)^T M\,(u - \tilde u), \qquad
+    \tilde u = u_n + h\,v_n ,
+
+with :math:`\Pi = \sum_k \Pi_k` the terms' potentials (:meth:`~skvalve.fem.problem.Problem.energy`: strain energy,
+barrier contact, ...), :math:`M` a diagonal mass (``mass``: e.g. :func:`~skvalve.fem.damping.lumped_volume` times the
+input's density) and :math:`h` the time step; without a mass the step is the static problem, with ``velocity=False``
+:math:`\tilde u = u_n` (pseudo-mass: a proximal step that damps, whose fixed point is still the static equilibrium).
+The stationarity of :math:`E` is implicit Euler. Each iteration solves
+
+.. math::
+
+    \big(\mathcal P[K] + M/h^2\big)\,p = -\nabla E
+
+with :math:`\mathcal P[K]` the tangent whose element blocks (and each contact stencil, ``Contribution.projected_matrix``)
+are projected onto their positive semidefinite parts (projected Newton: Teran et al. 2005), so :math:`p` is a descent
+direction; once the relative residual is below ``newton_below`` the unprojected tangent is used (Newton's quadratic
+rate), falling back to the projected one when its step is not a descent direction. The step length starts at the
+terms' cap (:meth:`~skvalve.fem.problem.Problem.step_fraction`: 0.9 of the collision-free share for a barrier, so no
+iterate intersects) and is halved until the Armijo condition :math:`E(u + \alpha p) \le E(u) + c\,\alpha\,\nabla E\cdot p`
+holds. Where a term has no potential (a follower pressure on an open surface is not conservative) the merit is the
+residual norm instead (``energy_merit`` False in the history): the line search then asks that :math:`|\nabla E|` falls.
+Converged: :math:`\lVert \nabla E_f\rVert \le \max(\text{rtol}\,f_\text{ref}, \text{atol})` (Newton's measure).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from tqdm.auto import tqdm
+
+from . import linsolve
+from .errors import ConvergenceError, NonPositiveJacobianError
+from .newton import StepEvent, reference_force
+from .problem import Problem, Tangent
+from .result import Result
+from .trust_steps import project_psd
+
+__all__ = ["IncrementalOptions", "incremental_potential", "projected_tangent"]
+
+logger = logging.getLogger("skvalve.fem")
+
+
+@dataclass
+class IncrementalOptions:
+    """Controls of :func:`incremental_potential` (module docstring)."""
+
+    rtol: float = 1e-8
+    atol: float = 0.0
+    max_iter: int = 60
+    max_cutbacks: int = 8
+    max_line_search: int = 40
+    newton_below: float = 1e-3
+    armijo: float = 1e-4
+    solver: str | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("rtol", "newton_below", "armijo"):
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0.0):
+                raise ValueError(f"{name} must be a finite number >= 0; got {value!r}")
+        if not self.rtol > 0.0:
+            raise ValueError(f"rtol must be positive; got {self.rtol!r}")
+        for name in ("max_iter", "max_cutbacks", "max_line_search"):
+            value = getattr(self, name)
+            if not isinstance(value, int) or isinstance(value, bool) or value < (1 if name == "max_iter" else 0):
+                raise ValueError(f"{name} must be a non-negative integer (max_iter >= 1); got {value!r}")
+
+
+class _StepFailed(Exception):
+    pass
+
+
+def projected_tangent(problem: Problem, tangent: Tangent) -> sp.csr_matrix:
+    """The free-dof tangent with every symmetric term's element blocks projected onto their PSD parts, a term's own
+    projected sparse matrix where it gives one (contact stencils) and the symmetric part of everything else."""
+
+    def blocks(term, matrices):
+        if getattr(term, "symmetric", True):
+            return project_psd(matrices)
+        return 0.5 * (matrices + np.swapaxes(matrices, -1, -2))
+
+    def matrix(term, sparse):
+        return 0.5 * (sparse + sparse.T)
+
+    return problem.tangent_matrix(tangent, blocks=blocks, matrix=matrix, projected=True).tocsr()
+
+
+def incremental_potential(problem: Problem, steps=10, *, mass: np.ndarray | None = None, time_step: float = 1.0,
+                          velocity: bool = True, options: IncrementalOptions | None = None,
+                          u0: np.ndarray | None = None, t0: float = 0.0,
+                          callbacks: Sequence[Callable[[StepEvent], None]] = (), progress: bool = True) -> Result:
+    """Follow the load factors ``steps`` (int: uniform to 1; or increasing factors), each step a minimisation.
+
+    ``mass``: diagonal (n_dofs,) or ``None`` (static); ``time_step`` :math:`h`; ``velocity`` False for a pseudo-mass
+    (:math:`\\tilde u = u_n`). Returns a :class:`~skvalve.fem.result.Result` (each step's history records the
+    iterations, step lengths, whether the energy was the merit and how many steps the collision cap shortened);
+    raises :class:`~skvalve.fem.errors.ConvergenceError` after ``max_cutbacks`` halvings of a load step.
+    """
+    opts = options or IncrementalOptions()
+    solver = linsolve.solver_name(opts.solver)
+    if isinstance(steps, int | np.integer) and not isinstance(steps, bool):
+        if steps < 1:
+            raise ValueError(f"steps must be >= 1; got {steps!r}")
+        factors = list(np.linspace(t0, 1.0, int(steps) + 1)[1:])
+    else:
+        factors = [float(f) for f in np.asarray(steps, dtype=float).ravel()]
+        if not factors or np.any(np.diff([t0, *factors]) <= 0.0) or not np.all(np.isfinite(factors)):
+            raise ValueError("load factors must be finite and increase from t0")
+    if not (math.isfinite(time_step) and time_step > 0.0):
+        raise ValueError(f"time_step must be positive; got {time_step!r}")
+    n = problem.space.n_dofs
+    weights = np.zeros(n) if mass is None else np.array(mass, dtype=float).ravel()
+    if weights.shape != (n,) or not np.all(np.isfinite(weights) & (weights >= 0.0)):
+        raise ValueError(f"mass must be {n} finite values >= 0")
+    problem.check_supports()
+    u = np.zeros(n) if u0 is None else np.array(u0, dtype=float)
+    v = np.zeros(n)
+    residual, _ = problem.assemble(u, t0, tangent=False, step=0)
+    problem.commit()
+    result = Result(problem, solver=solver)
+    result.append(t0, u, residual, [])
+    for callback in callbacks:
+        callback(StepEvent(problem, 0, t0, u, result))
+    t, target, failures = t0, 0, 0
+    increment = factors[0] - t0
+    bar = tqdm(total=len(factors), disable=not progress, desc="incremental potential", leave=False)
+    try:
+        while target < len(factors):
+            t_new = min(t + increment, factors[target])
+            step = len(result.load_factors)
+            predictor = u + (time_step * v if velocity and mass is not None else 0.0)
+            try:
+                u_new, residual, history = _minimise(problem, u, t, t_new, predictor, weights / time_step ** 2,
+                                                     step, opts, solver)
+            except (_StepFailed, NonPositiveJacobianError, np.linalg.LinAlgError) as err:
+                problem.rewind()
+                failures += 1
+                logger.info("incremental step %d to t=%.4g failed (%s); cut-back %d", step, t_new, err, failures)
+                if failures > opts.max_cutbacks:
+                    error = ConvergenceError(f"load step {step} to load factor {t_new:.6g} failed after "
+                                             f"{opts.max_cutbacks} cut-backs: {err}")
+                    error.last_converged = result
+                    raise error from err
+                increment = 0.5 * (t_new - t)
+                continue
+            problem.commit()
+            problem.check_state(u_new, t_new)
+            if mass is not None:
+                v = (u_new - u) / time_step
+            u, t = u_new, t_new
+            result.append(t, u, residual, history)
+            for callback in callbacks:
+                callback(StepEvent(problem, step, t, u, result))
+            if t >= factors[target] - 1e-14:
+                target += 1
+                bar.update(1)
+                if target < len(factors):
+                    increment = factors[target] - t if failures == 0 else min(2 * increment, factors[target] - t)
+            else:
+                increment = min(2.0 * increment, factors[target] - t) if failures else increment
+            failures = 0
+    finally:
+        bar.close()
+    return result
+
+
+def _minimise(problem: Problem, u_old, t_old: float, t_new: float, predictor, inertia, step: int,
+              opts: IncrementalOptions, solver: str):
+    """One load step: the minimiser of the incremental potential (its state, static residual and history)."""
+    pattern = problem.pattern
+    fixed, free = pattern.fixed, pattern.free
+    u = u_old.copy()
+    _, values = problem.constrained(t_new)
+    u[fixed] = values
+    if problem.step_fraction(u_old, t_old, u, t_new) < 1.0:
+        raise _StepFailed(f"the prescribed motion from load factor {t_old:.6g} to {t_new:.6g} is not collision-free")
+
+    def merit(state: np.ndarray, gradient: np.ndarray) -> float:
+        energy = problem.energy(state, t_new)
+        if energy is None:
+            return float(np.linalg.norm(gradient[free]))
+        d = state - predictor
+        return energy + 0.5 * float(d @ (inertia * d))
+
+    residual, tangent = problem.assemble(u, t_new, tangent=True, step=step)
+    gradient = residual + inertia * (u - predictor)
+    value = merit(u, gradient)
+    energy_merit = problem.energy(u, t_new) is not None
+    history = []
+    for iteration in range(1, opts.max_iter + 1):
+        reference = reference_force(problem, residual, fixed)
+        norm = float(np.linalg.norm(gradient[free]))
+        if norm <= max(opts.rtol * reference, opts.atol):
+            return u, residual, history
+        clock = time.perf_counter()
+        newton = norm <= opts.newton_below * reference
+        K = problem.tangent_matrix(tangent) if newton else projected_tangent(problem, tangent)
+        K = K + sp.diags(inertia[free], format="csr")
+        direction = linsolve.solve(K, -gradient[free], solver, symmetric=problem.symmetric or not newton)
+        if newton and not float(direction @ gradient[free]) < 0.0:  # not a descent direction: projected instead
+            newton = False
+            K = projected_tangent(problem, tangent) + sp.diags(inertia[free], format="csr")
+            direction = linsolve.solve(K, -gradient[free], solver, symmetric=True)
+        p = np.zeros_like(u)
+        p[free] = direction
+        cap = problem.step_fraction(u, t_new, u + p, t_new)
+        alpha, slope = cap, float(direction @ gradient[free])
+        accepted = None
+        for _ in range(opts.max_line_search + 1):
+            trial = u + alpha * p
+            try:
+                trial_residual, trial_tangent = problem.assemble(trial, t_new, tangent=True, step=step)
+            except NonPositiveJacobianError:
+                alpha *= 0.5
+                continue
+            trial_gradient = trial_residual + inertia * (trial - predictor)
+            trial_value = merit(trial, trial_gradient)
+            if energy_merit:
+                ok = trial_value <= value + opts.armijo * alpha * slope
+            else:
+                ok = trial_value <= (1.0 - opts.armijo * alpha) * value
+            if ok and np.isfinite(trial_value):
+                accepted = (trial, trial_residual, trial_tangent, trial_gradient, trial_value)
+                break
+            alpha *= 0.5
+        if accepted is None:
+            raise _StepFailed(f"line search: no decrease of the {'energy' if energy_merit else 'residual'} along the "
+                              f"step (iteration {iteration}, relative residual {norm / reference:.3e})")
+        u, residual, tangent, gradient, value = accepted
+        history.append({"step": step, "load_factor": t_new, "iteration": iteration, "alpha": alpha, "cap": cap,
+                        "newton": newton, "energy_merit": energy_merit,
+                        "residual": float(np.linalg.norm(gradient[free])),
+                        "relative_residual": float(np.linalg.norm(gradient[free])) / reference,
+                        "seconds": time.perf_counter() - clock})
+    raise _StepFailed(f"no convergence in {opts.max_iter} iterations (relative residual "
+                      f"{float(np.linalg.norm(gradient[free])) / reference_force(problem, residual, fixed):.3e})")

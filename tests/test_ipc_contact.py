@@ -1,0 +1,219 @@
+"""IPC barrier contact (skvalve.fem.contact.ipc): derivatives against central differences, the plane-vertex pressure
+in closed form, blocks and sheets pressed together and onto rigid surfaces without an intersection at any accepted
+state, and a block that passes straight through an obstacle once the solvers' collision-free cap is removed."""
+
+import numpy as np
+import pytest
+import skfem
+from scipy.optimize import brentq
+
+from skvalve.fem import Solid, Space, solve
+from skvalve.fem.contact import (
+    IntersectionError,
+    IPCContact,
+    Obstacle,
+    Plane,
+    barrier_pressure,
+    stiffness_for_pressure,
+)
+from skvalve.fem.contact.ipc import Friction
+from skvalve.fem.incremental import IncrementalOptions, incremental_potential
+from skvalve.fem.meshes import box
+from skvalve.fem.ptc import PseudoTransientOptions, pseudo_transient
+from skvalve.materials import NeoHookean
+
+MATERIAL = NeoHookean.from_shear_poisson(G=10.0, nu=0.3)
+
+
+def _two_blocks(gap: float):
+    """Two unit-ish blocks stacked along z with ``gap`` between them (one mesh, two components)."""
+    lower = box((2, 2, 1), (1.0, 1.0, 0.5))
+    upper = skfem.MeshHex.init_tensor(np.linspace(0.1, 0.9, 3), np.linspace(0.1, 0.9, 3),
+                                      np.linspace(0.5 + gap, 1.0 + gap, 2))
+    p = np.hstack([lower.p, upper.p])
+    t = np.hstack([lower.t, upper.t + lower.p.shape[1]])
+    return skfem.MeshHex(p, t)
+
+
+def test_barrier_gradient_and_hessian_match_central_differences():
+    mesh = _two_blocks(0.02)
+    space = Space(mesh)
+    contact = IPCContact(space, dhat=0.05, stiffness=50.0, planes=[Plane([0, 0, -0.01], [0, 0, 1])])
+    rng = np.random.default_rng(7)
+    u = 2e-3 * rng.standard_normal(space.n_dofs)
+    assert contact.active_pairs(u, 0.0) > 10
+    c = contact.assemble(u, 0.0, True, None)
+    h = 1e-7
+    for _ in range(3):
+        v = rng.standard_normal(space.n_dofs)
+        fd = (contact.energy(u + h * v, 0.0) - contact.energy(u - h * v, 0.0)) / (2 * h)
+        assert fd == pytest.approx(c.internal @ v, rel=1e-6)
+        g_plus = contact.assemble(u + h * v, 0.0, False, None).internal
+        g_minus = contact.assemble(u - h * v, 0.0, False, None).internal
+        assert np.linalg.norm((g_plus - g_minus) / (2 * h) - c.matrix @ v) <= 1e-6 * np.linalg.norm(c.matrix @ v)
+    # the projected Hessian is symmetric positive semidefinite; the exact one is symmetric
+    P = c.projected_matrix.toarray()
+    assert np.allclose(P, P.T) and np.linalg.eigvalsh(P).min() > -1e-8 * np.abs(P).max()
+    assert np.allclose(c.matrix.toarray(), c.matrix.toarray().T)
+
+
+def test_plane_vertex_pressure_is_the_closed_form():
+    """A block resting at distance d from a plane: every bottom node reports p(d) = -2 d kappa b'(d^2) / dhat^3."""
+    mesh = box((2, 2, 1), (1.0, 1.0, 0.2)).translated([0.0, 0.0, 0.01])
+    space = Space(mesh)
+    contact = IPCContact(space, dhat=0.05, stiffness=10.0, planes=[Plane([0, 0, 0], [0, 0, 1])])
+    u = np.zeros(space.n_dofs)
+    bottom = mesh.p[2] < 0.011
+    d, dhat = 0.01, 0.05
+    s, sh = d * d, dhat * dhat
+    closed = 2 * d * 10.0 * (2 * (s - sh) * np.log(s / sh) + (s - sh) ** 2 / s) / dhat ** 3
+    assert contact.nodal_pressure(u, 0.0)[bottom] == pytest.approx(np.full(bottom.sum(), closed), rel=1e-12)
+    assert barrier_pressure(d, dhat, 10.0) == pytest.approx(closed, rel=1e-14)
+    assert barrier_pressure(dhat, dhat, 10.0) == 0.0
+    assert barrier_pressure(0.5 * dhat, dhat, stiffness_for_pressure(3.0, dhat)) == pytest.approx(3.0, rel=1e-12)
+    force = contact.assemble(u, 0.0, False, None).internal.reshape(-1, 3)
+    assert force[bottom, 2].sum() == pytest.approx(-closed * contact.area[bottom].sum(), rel=1e-12)
+
+
+def _pressed_sheet(pressure: float, dhat: float, kappa: float):
+    """A sheet on rollers (u_x = u_y = 0) pushed by a follower pressure on its bottom against a plane above it."""
+    mesh = box((3, 3, 1), (1.0, 1.0, 0.1))
+    solid = Solid(mesh, MATERIAL)
+    solid.add_dirichlet(lambda X: np.ones(X.shape[1], dtype=bool), 0.0, components=[0, 1])
+    solid.add_pressure(lambda x: x[2] < 1e-9, pressure)
+    contact = IPCContact(solid.space, dhat=dhat, stiffness=kappa, planes=[Plane([0, 0, 0.108], [0, 0, -1])],
+                         check_intersections=True)
+    contact.supports = True
+    solid.add_term(contact)
+    return solid, contact, mesh
+
+
+def test_sheet_inflated_against_a_plane_carries_the_pressure_at_the_closed_form_gap():
+    """At equilibrium the plane carries the inflation pressure at every top node, at the gap d* with p(d*) = P."""
+    P, dhat, kappa = 2.0, 0.01, 5.0
+    solid, contact, mesh = _pressed_sheet(P, dhat, kappa)
+    result = solve(solid, steps=8, rtol=1e-10, progress=False)
+    u = result.solutions[-1]
+    top = np.flatnonzero(mesh.p[2] > 0.1 - 1e-9)
+    gap = 0.108 - (mesh.p[2, top] + u[3 * top + 2])
+    expected = brentq(lambda d: barrier_pressure(d, dhat, kappa) - P, 1e-9, dhat * (1 - 1e-12))
+    assert gap == pytest.approx(np.full(top.size, expected), rel=1e-6)
+    assert contact.nodal_pressure(u, 1.0)[top] == pytest.approx(np.full(top.size, P), rel=1e-6)
+    assert contact.contact_area(u, 1.0) == pytest.approx(1.0, rel=1e-9)  # the top face; the bottom feels nothing
+
+
+def _block_over_obstacle(drop: float, gap: float, dhat: float):
+    """A block whose top face is moved down by ``drop`` towards a fixed square obstacle ``gap`` below it."""
+    mesh = box((2, 2, 2), (1.0, 1.0, 0.5))
+    solid = Solid(mesh, MATERIAL)
+    solid.add_dirichlet(lambda X: X[2] > 0.5 - 1e-9, np.array([0.0, 0.0, -drop]))
+    sheet = Obstacle.rectangle([0.5, 0.5, -gap], [0, 0, 1], size=2.0, divisions=2)
+    contact = IPCContact(solid.space, dhat=dhat, stiffness=20.0, obstacles=[sheet], check_intersections=True)
+    solid.add_term(contact)
+    return solid, contact, mesh
+
+
+def test_block_pressed_onto_an_obstacle_never_intersects_and_balances_forces():
+    solid, contact, mesh = _block_over_obstacle(drop=0.2, gap=0.05, dhat=0.02)
+    result = solve(solid, steps=1, rtol=1e-9, progress=False)
+    u = result.solutions[-1]
+    assert not contact.intersects(u, 1.0)
+    distance = contact.minimum_distance(u, 1.0)
+    assert 0.0 < distance < 0.02
+    top = lambda X: X[2] > 0.5 - 1e-9
+    reaction = result.reaction(top)
+    contact_force = contact.assemble(u, 1.0, False, None).internal.reshape(-1, 3).sum(axis=0)
+    assert reaction[2] == pytest.approx(-contact_force[2], rel=1e-6)  # what the supports push, the obstacle takes
+    assert reaction[2] < 0.0
+
+
+def test_without_the_collision_free_cap_the_block_passes_through(monkeypatch):
+    """The same load step with the cap removed: Newton's first iterate carries the block past the sheet, beyond the
+    barrier's range, and the solve 'converges' to an intersecting state (the debug check raises)."""
+    solid, contact, _ = _block_over_obstacle(drop=0.2, gap=0.05, dhat=0.02)
+    monkeypatch.setattr(IPCContact, "step_fraction", lambda self, u0, t0, u1, t1: 1.0)
+    with pytest.raises(IntersectionError):
+        solve(solid, steps=1, rtol=1e-9, progress=False)
+
+
+def test_incremental_potential_presses_two_blocks_with_no_intersection_at_any_iterate():
+    """Self-contact of two blocks: the lower one clamped at its base, the upper one's top moved down past the gap.
+    Every line-search trial is checked, not only the accepted states."""
+    mesh = _two_blocks(0.05)
+    solid = Solid(mesh, MATERIAL)
+    solid.add_dirichlet(lambda X: X[2] < 1e-9, 0.0)
+    solid.add_dirichlet(lambda X: X[2] > 1.05 - 1e-9, np.array([0.0, 0.0, -0.12]))
+    contact = IPCContact(solid.space, dhat=0.02, stiffness=20.0, check_intersections=True)
+    solid.add_term(contact)
+    trials = []
+    original = IPCContact.assemble
+
+    def watched(self, u, t, tangent, step):
+        trials.append(self.intersects(u, t))
+        return original(self, u, t, tangent, step)
+
+    IPCContact.assemble = watched
+    try:
+        result = incremental_potential(solid, steps=2, options=IncrementalOptions(rtol=1e-9), progress=False)
+    finally:
+        IPCContact.assemble = original
+    u = result.solutions[-1]
+    assert len(trials) > 5 and not any(trials)
+    assert 0.0 < contact.minimum_distance(u, 1.0) < 0.02
+    upper_top = lambda X: X[2] > 1.05 - 1e-9
+    lower_base = lambda X: X[2] < 1e-9
+    assert result.reaction(upper_top)[2] == pytest.approx(-result.reaction(lower_base)[2], rel=1e-6)
+    history = [record for step in result.histories for record in step]
+    assert any(record["energy_merit"] for record in history)
+    assert history[-1]["newton"]  # the last iterations use the unprojected tangent
+
+
+def test_incremental_potential_agrees_with_newton_on_the_pressed_block():
+    solid, contact, _ = _block_over_obstacle(drop=0.1, gap=0.05, dhat=0.02)
+    newton = solve(solid, steps=2, rtol=1e-10, progress=False).solutions[-1]
+    solid2, _, _ = _block_over_obstacle(drop=0.1, gap=0.05, dhat=0.02)
+    minimised = incremental_potential(solid2, steps=2, options=IncrementalOptions(rtol=1e-10),
+                                      progress=False).solutions[-1]
+    assert np.abs(minimised - newton).max() <= 1e-7 * np.abs(newton).max()
+
+
+def test_pseudo_transient_steps_are_capped_too():
+    solid, contact, _ = _block_over_obstacle(drop=0.15, gap=0.05, dhat=0.02)
+    weights = np.ones(solid.space.n_dofs) * 1e-3
+    result = pseudo_transient(solid, weights, 1.0, PseudoTransientOptions(first_step=0.5, rtol=1e-8), progress=False)
+    assert result.converged
+    assert not contact.intersects(result.u, 1.0)
+    assert 0.0 < contact.minimum_distance(result.u, 1.0) < 0.02
+
+
+def test_moving_obstacle_pushes_a_block_and_friction_holds_it():
+    """A rigid square moved up into a block clamped at its top; with friction the contact also resists sliding."""
+    mesh = box((2, 2, 1), (1.0, 1.0, 0.4))
+    solid = Solid(mesh, MATERIAL)
+    solid.add_dirichlet(lambda X: X[2] > 0.4 - 1e-9, 0.0)
+    punch = Obstacle.rectangle([0.5, 0.5, -0.03], [0, 0, 1], size=0.6, divisions=1,
+                               motion=lambda t: np.array([0.1 * t, 0.0, 0.1 * t]))
+    contact = IPCContact(solid.space, dhat=0.02, stiffness=20.0, obstacles=[punch], check_intersections=True,
+                         friction=Friction(mu=0.5, slip=1e-3))
+    solid.add_term(contact)
+    result = solve(solid, steps=8, rtol=1e-8, progress=False)
+    u = result.solutions[-1]
+    assert not contact.intersects(u, 1.0)
+    assert 0.0 < contact.minimum_distance(u, 1.0) < 0.02
+    bottom_centre = int(np.argmin(np.linalg.norm(mesh.p.T - [0.5, 0.5, 0.0], axis=1)))
+    assert u[3 * bottom_centre + 2] > 0.05  # pushed up by the punch
+    assert u[3 * bottom_centre] > 0.0  # and dragged along by friction
+
+
+def test_bad_input_is_named():
+    space = Space(box(1))
+    with pytest.raises(ValueError, match="dhat"):
+        IPCContact(space, dhat=0.0, stiffness=1.0)
+    with pytest.raises(ValueError, match="stiffness"):
+        IPCContact(space, dhat=0.1, stiffness=float("nan"))
+    with pytest.raises(ValueError, match="obstacle 'arm'"):
+        Obstacle(np.zeros((3, 3)), [[0, 1, 5]], name="arm")
+    with pytest.raises(ValueError, match="plane"):
+        Plane([0, 0, 0], [0, 0, 0])
+    with pytest.raises(IntersectionError, match="reference"):  # an obstacle cutting through the body at rest
+        IPCContact(space, dhat=0.1, stiffness=1.0, obstacles=[Obstacle.rectangle([0.5, 0.5, 0.5], [0, 0, 1], 2.0)])
