@@ -92,9 +92,19 @@ def trivalve_input() -> Path | None:
     """The Texas TriValve 1.0 diseased input if present: ``$SKVALVE_TRIVALVE`` or ``../shared/data/...``.
 
     ``$SKVALVE_TRIVALVE`` may name the ``.inp`` file or its folder (the diseased input in it, or one level
-    down as in ``texas_trivalve_1.1/Diseased/``).
+    down as in ``texas_trivalve_1.1/Diseased/``); a folder without the input gives ``None``. Unset or empty,
+    the shared data are searched.
+
+    Raises
+    ------
+    FileNotFoundError
+        When ``$SKVALVE_TRIVALVE`` is set to a path that does not exist (a mistyped path is never replaced by
+        another copy of the data).
     """
     env = os.environ.get("SKVALVE_TRIVALVE")
+    if env and not Path(env).exists():
+        raise FileNotFoundError(f"$SKVALVE_TRIVALVE is set to {env!r}, which does not exist: set it to the Texas "
+                                "TriValve .inp file or its folder, or unset it to search ../shared/data")
     if env and Path(env).is_file():
         return Path(env)
     if env and Path(env).is_dir():
