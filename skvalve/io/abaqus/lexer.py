@@ -8,7 +8,9 @@ Rules followed (Abaqus Analysis User's Guide, "Input syntax rules"):
   a keyword line ending with a comma continues on the next line;
 * ``*Include, input=FILE`` is replaced by FILE's cards (FILE relative to the including file;
   a file that includes itself, directly or not, is an error);
-* a data field left blank means "default"; a trailing comma does not open a further field.
+* a data field left blank means "default"; a trailing comma does not open a further field;
+* a file whose last data line has no final newline is an error (a cut file: the number may be cut); a
+  last keyword line without one is marked ``Card.unterminated`` (:func:`~skvalve.io.abaqus.read_model` warns).
 
 Bytes: a UTF-8 byte-order mark is dropped, lines that are not UTF-8 are read as latin-1 (so a stray
 byte in a comment does no harm) and carriage returns are removed.
@@ -63,6 +65,8 @@ class Card:
     location: Location
     texts: list[str] = field(default_factory=list)
     numbers: list[int] = field(default_factory=list)
+    #: the keyword line is the file's last line and has no final newline (the file may have been cut there)
+    unterminated: bool = False
 
     @cached_property
     def data(self) -> list[DataLine]:
@@ -193,6 +197,7 @@ def read_cards(path: Path, _stack: tuple[Path, ...] = ()) -> list[Card]:
             continued = (text, location)
             continue
         current = _parse_keyword_line(text, location)
+        current.unterminated = unterminated and number == last
         if current.keyword == "include":
             target = current.require("input")
             if current.texts:

@@ -62,6 +62,8 @@ def read_nodes(card: Card, scope: MeshScope) -> None:
     """``*Node``: label and up to three coordinates per line (missing coordinates are 0)."""
     if card.parameters.get("system", "R").upper() != "R":
         raise card.error("only rectangular nodal coordinates (SYSTEM=R) are supported")
+    if not card.texts and "input" not in card.parameters:  # INPUT= is rejected with its own message
+        raise card.error("no data lines (label, coordinates): the block is empty or the file cut short")
     table = fast_table(card, 4, integer=False)
     if table is not None and np.all(np.abs(table[:, 0]) <= MAX_INT) and \
             all(_INT.fullmatch(text.split(",", 1)[0].strip()) for text in card.texts):
@@ -99,6 +101,8 @@ def read_elements(card: Card, scope: MeshScope) -> None:
     if element_type not in NODES_PER_ELEMENT:
         raise card.error(f"unsupported element type {element_type}")
     per_element = NODES_PER_ELEMENT[element_type]
+    if not card.texts and "input" not in card.parameters:
+        raise card.error("no data lines (label, nodes): the block is empty or the file cut short")
     table = fast_table(card, per_element + 1, integer=True)
     if table is None:
         table = _read_element_lines(card, element_type, per_element)

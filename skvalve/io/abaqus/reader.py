@@ -14,12 +14,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import AbaqusParseError
+from .errors import AbaqusParseError, Location
 from .lexer import Card, data_values, read_cards
 from .materials import MATERIAL_OPTIONS, AbaqusMaterial, read_material_option
 from .mesh import MeshScope, instance_part
 from .mesh_cards import read_elements, read_nodes, read_section, read_set, read_surface
-from .model import AbaqusModel, IgnoredKeyword, Instance
+from .model import AbaqusModel, IgnoredKeyword, Instance, ReadWarning
 from .state import ParseState
 from .step_cards import HISTORY_HANDLERS
 
@@ -204,6 +204,34 @@ def _check_references(state: ParseState) -> None:
             raise AbaqusParseError(f"unknown surface interaction {pair.interaction!r}", pair.location)
 
 
+def _check_end_of_file(cards: list[Card], state: ParseState) -> None:
+    """What a file cut at a line leaves behind: nothing at all, a ``*Material`` without options, model data of
+    parts and an assembly without any ``*Step``, a last keyword line without its newline.
+
+    Errors where the input cannot be whole (nothing read, a last ``*Material`` with nothing after it), warnings
+    (``state.warnings``) where Abaqus reads it as it is.
+    """
+    if not cards:
+        raise AbaqusParseError("no keyword lines: an empty file, or not an Abaqus input", Location(state.path, 1))
+    last = cards[-1]
+    if state.assembly.n_nodes == 0 and not (state.parts or state.materials or state.steps):
+        raise AbaqusParseError("the input defines no nodes, parts, materials or steps: an empty or cut file?",
+                               last.location)
+    for card, following in zip(cards, [*cards[1:], None], strict=True):
+        if card.keyword != "material" or (following is not None and following.keyword in MATERIAL_OPTIONS):
+            continue
+        if following is None:
+            raise card.error("the file ends after *Material: a material without options (the file cut short?)")
+        state.warnings.append(ReadWarning(f"material {card.parameters.get('name')!r} has no material options",
+                                          card.location))
+    if (state.parts or state.assembly_seen) and not state.steps:
+        state.warnings.append(ReadWarning("parts and an assembly but no *Step: the history data (steps, loads) "
+                                          "are missing, or the file was cut short", last.location))
+    if last.unterminated and not last.keyword.startswith("end "):
+        state.warnings.append(ReadWarning(f"the file ends in this *{last.title} line without a final newline: "
+                                          "cut short?", last.location))
+
+
 def _assemble(state: ParseState) -> AbaqusModel:
     assembly = state.assembly
     scopes = [""] + [inst.name for inst, _ in assembly.instances.values()]
@@ -228,7 +256,7 @@ def _assemble(state: ParseState) -> AbaqusModel:
         interactions=state.interactions, mpcs=state.mpcs, rigid_bodies=state.rigid_bodies,
         connector_sections=state.connector_sections, transforms=state.transforms, steps=state.steps,
         ignored=state.ignored, part_names=state.part_names)
-    model.warnings = [w for scope in (assembly, *state.parts.values()) for w in scope.warnings]
+    model.warnings = [w for scope in (assembly, *state.parts.values()) for w in scope.warnings] + state.warnings
     model._node_lookup = lookup
     return model
 
@@ -249,6 +277,7 @@ def read_model(path: str | os.PathLike) -> AbaqusModel:
         raise AbaqusParseError("the file ends inside a *Part, *Assembly or *Instance", last.location if last else None)
     if state.step is not None:
         raise AbaqusParseError(f"step {state.step.name!r} has no *End Step", state.step.location)
+    _check_end_of_file(cards, state)
     _check_references(state)
     model = _assemble(state)
     for warning in model.warnings:

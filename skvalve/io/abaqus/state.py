@@ -18,6 +18,7 @@ from .model import (
     DistributedLoad,
     GeneralContact,
     IgnoredKeyword,
+    ReadWarning,
     RigidBody,
     Step,
     SurfaceInteraction,
@@ -60,6 +61,8 @@ class ParseState:
     transforms: list[Transform] = field(default_factory=list)
     steps: list[Step] = field(default_factory=list)
     ignored: list[IgnoredKeyword] = field(default_factory=list)
+    #: reader warnings outside the mesh scopes (an empty material, a cut last keyword line, ...)
+    warnings: list[ReadWarning] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         self.scope = self.assembly

@@ -40,6 +40,13 @@ def _op(card: Card) -> str:
     return op
 
 
+def _require_data(card: Card, op: str) -> None:
+    """Boundary conditions and loads need data lines; only ``OP=NEW`` (remove the previous ones) comes without."""
+    if not card.data and op != "NEW":
+        raise card.error("no data lines (only OP=NEW may come without them): the block is empty or the file cut "
+                         "short")
+
+
 def _surface_name(token: str, state: ParseState, card: Card, location) -> str:
     if token.upper() not in state.assembly.surfaces:
         raise card.error(f"unknown surface {token!r}", location)
@@ -76,6 +83,7 @@ def read_boundary(card: Card, state: ParseState) -> None:
     op, amplitude = _op(card), card.parameters.get("amplitude")
     kind = card.parameters.get("type", "DISPLACEMENT").upper()
     target = state.step.boundary_conditions if state.step else state.boundary_conditions
+    _require_data(card, op)
     for line in card.data:
         fields = split_fields(line.text)
         if len(fields) < 2 or len(fields) > 4 or not fields[0]:
@@ -105,6 +113,7 @@ def read_dsload(card: Card, state: ParseState) -> None:
     step = _require_step(card, state)
     op, amplitude = _op(card), card.parameters.get("amplitude")
     follower = card.parameters.get("follower", "YES").upper() != "NO"
+    _require_data(card, op)
     for line in card.data:
         fields = split_fields(line.text)
         if len(fields) != 3 or not fields[0]:
@@ -121,6 +130,7 @@ def read_dsload(card: Card, state: ParseState) -> None:
 def read_cload(card: Card, state: ParseState) -> None:
     step = _require_step(card, state)
     op, amplitude = _op(card), card.parameters.get("amplitude")
+    _require_data(card, op)
     for line in card.data:
         fields = split_fields(line.text)
         if len(fields) != 3 or not fields[0]:
@@ -213,6 +223,8 @@ def read_surface_behavior(card: Card, state: ParseState) -> None:
 
 def read_mpc(card: Card, state: ParseState) -> None:
     scope = state.model_scope(card)
+    if not card.data:
+        raise card.error("no data lines (type, node or set, node or set): the block is empty or the file cut short")
     for line in card.data:
         fields = split_fields(line.text)
         if len(fields) < 3 or not all(fields):
