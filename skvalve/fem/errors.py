@@ -11,7 +11,7 @@ import numpy as np
 
 __all__ = [
     "SolverError", "ConvergenceError", "NonPositiveJacobianError", "SingularSystemError", "OutputError",
-    "TangledMeshError",
+    "TangledMeshError", "LoadError",
 ]
 
 
@@ -49,6 +49,29 @@ class SingularSystemError(SolverError):
     def __init__(self, message: str, step: int | None = None, load_factor: float | None = None) -> None:
         self.step, self.load_factor = step, load_factor
         super().__init__(message)
+
+
+class LoadError(SolverError):
+    """A load or prescribed value that is not a finite number where it is evaluated: names the load (its callable
+    or value), its term (``"nodal force"``, ``"follower pressure"``, ``"prescribed displacement"``) and the load
+    factor.
+
+    Not a ``ValueError``: the solvers do not take it for a failed step to cut back, it ends the solve at once.
+    """
+
+    def __init__(self, term: str, load, load_factor: float, detail: str, where: str = "") -> None:
+        self.term, self.load, self.load_factor, self.where = term, load, load_factor, where
+        on = f" ({where})" if where else ""
+        super().__init__(f"{term}{on} {_load_name(load)} at load factor {load_factor:.6g}: {detail}")
+
+
+def _load_name(load) -> str:
+    """A callable's qualified name (``force_at`` or ``<lambda>``), else its value's repr (shortened)."""
+    name = getattr(load, "__qualname__", None) or getattr(type(load), "__qualname__", "load")
+    if callable(load):
+        return name
+    text = repr(load)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 class OutputError(SolverError):

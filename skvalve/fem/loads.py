@@ -26,11 +26,13 @@ from collections.abc import Callable
 import numpy as np
 import skfem as fem
 
+from ..materials.base import check_array
+from .errors import LoadError
 from .kernels import element_gradients
 from .space import Space
 from .terms import Blocks, Contribution, Term
 
-__all__ = ["Dirichlet", "FollowerPressure", "NodalForce", "load_function", "embed_3d"]
+__all__ = ["Dirichlet", "FollowerPressure", "NodalForce", "load_function", "evaluated_load", "embed_3d"]
 
 _LEVI_CIVITA = np.zeros((3, 3, 3))
 for _i, _j, _k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
@@ -38,13 +40,42 @@ for _i, _j, _k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
 
 
 def load_function(value, ramp: bool = True, name: str = "load") -> Callable[[float], np.ndarray]:
-    """``t -> value * t`` (ramped), ``t -> value`` (fixed) or the callable itself."""
+    """``t -> value * t`` (ramped), ``t -> value`` (fixed) or the callable itself.
+
+    A value that is not a number or an array of numbers is a ``TypeError`` naming ``name`` (its values are checked
+    when the callable is evaluated, :func:`evaluated_load`); a non-finite value is a ``ValueError``.
+    """
     if callable(value):
         return value
-    array = np.asarray(value, dtype=float)
+    array = check_array(name, value, finite=False)
     if not np.all(np.isfinite(array)):
         raise ValueError(f"{name} must be finite; got {value!r}")
     return (lambda t: array * t) if ramp else (lambda t: array)
+
+
+def evaluated_load(value, term: str, load, t: float, shape: tuple[int, ...] | None = None,
+                   where: str = "") -> np.ndarray:
+    """``value``, what ``load`` gave at load factor ``t``, as a finite float array (reshaped to ``shape``).
+
+    Raises :class:`~skvalve.fem.errors.LoadError` naming the load, its ``term`` (and ``where`` it acts) and ``t``
+    for anything that is not finite numbers of that shape: the solvers then stop at once instead of cutting the
+    step back on a NaN residual.
+    """
+    try:
+        array = check_array(term, value, finite=False)
+    except (TypeError, ValueError):
+        raise LoadError(term, load, t, f"returned {value!r}, not numbers", where) from None
+    if shape is not None:
+        try:
+            array = array.reshape(shape)
+        except ValueError:
+            raise LoadError(term, load, t, f"returned an array of shape {array.shape}, expected "
+                            f"{'one number' if shape == () else shape}", where) from None
+    if not np.all(np.isfinite(array)):
+        bad = np.flatnonzero(~np.isfinite(array.ravel()))
+        raise LoadError(term, load, t, f"returned non-finite values ({array.ravel()[bad[0]]} at entry "
+                        f"{int(bad[0])}, {bad.size} of {array.size} entries)", where)
+    return array
 
 
 def embed_3d(H: np.ndarray) -> np.ndarray:
@@ -78,17 +109,27 @@ class Dirichlet:
                 ) from err
 
     def values(self, t: float) -> np.ndarray:
-        """Prescribed values at load factor ``t``, shape (ncomp, n)."""
+        """Prescribed values at load factor ``t``, shape (ncomp, n).
+
+        Raises :class:`~skvalve.fem.errors.LoadError` (naming the value, its components and nodes and ``t``) when
+        a callable value does not give finite numbers of the shape ``(dim, n)``, ``(dim,)`` or ``(dim, 1)``.
+        """
+        term = "prescribed displacement"
+        where = f"components {self.components.tolist()} of {self.dofs.shape[1]} node(s)"
         if callable(self.value):
-            full = np.asarray(self.value(self.coordinates, t), dtype=float)
-            full = np.broadcast_to(full if full.ndim == 2 else full.reshape(-1, 1), (self.dim, self.dofs.shape[1]))
+            full = evaluated_load(self.value(self.coordinates, t), term, self.value, t, where=where)
+            try:
+                full = np.broadcast_to(full if full.ndim == 2 else full.reshape(-1, 1),
+                                       (self.dim, self.dofs.shape[1]))
+            except ValueError:
+                raise LoadError(term, self.value, t, f"returned an array of shape {full.shape}, expected "
+                                f"({self.dim}, {self.dofs.shape[1]}) or ({self.dim},)", where) from None
             out = full[self.components]
         else:
             array = np.asarray(self.value, dtype=float)
             array = array.reshape(array.shape + (1,) * (array.ndim == 1))
-            out = np.broadcast_to(array * (t if self.ramp else 1.0), self.dofs.shape)
-        if not np.all(np.isfinite(out)):
-            raise ValueError(f"prescribed displacement is not finite at load factor {t}")
+            out = evaluated_load(np.broadcast_to(array * (t if self.ramp else 1.0), self.dofs.shape), term,
+                                 self.value, t, where=where)
         return out
 
 
@@ -100,7 +141,8 @@ class NodalForce(Term):
 
     def __init__(self, space: Space, scalar_dofs: np.ndarray, force, ramp: bool) -> None:
         self.dofs = space.displacement_dofs(scalar_dofs)
-        self.force = load_function(force, ramp, "nodal force")
+        self.source = force
+        self.force = load_function(force, ramp, "force")
         self.dim = space.dim
         self.n_dofs = space.n_dofs
 
@@ -109,8 +151,12 @@ class NodalForce(Term):
 
     def vector(self, n_dofs: int, t: float) -> np.ndarray:
         f = np.zeros(n_dofs)
-        value = np.asarray(self.force(t), dtype=float).reshape(self.dim, -1)
-        np.add.at(f, self.dofs, np.broadcast_to(value, self.dofs.shape))
+        where = f"on {self.dofs.shape[1]} node(s)"
+        value = evaluated_load(self.force(t), self.name, self.source, t, where=where)
+        if value.size not in (self.dim, self.dofs.size):
+            raise LoadError(self.name, self.source, t, f"returned an array of shape {value.shape}, expected "
+                            f"({self.dim},) or ({self.dim}, {self.dofs.shape[1]})", where)
+        np.add.at(f, self.dofs, np.broadcast_to(value.reshape(self.dim, -1), self.dofs.shape))
         return f
 
 
@@ -131,7 +177,12 @@ class FollowerPressure(Term):
                 "a follower pressure acts on boundary facets only"
             )
         self.n_dofs = space.n_dofs
+        self.source = pressure
         self.pressure = load_function(pressure, ramp, "pressure")
+        if not callable(pressure) and np.size(pressure) != 1:
+            raise ValueError(f"parameter pressure must be one number (or a callable p(t)); got shape "
+                             f"{np.shape(pressure)}")
+        self.n_facets = facets.size
         self.dim = space.dim
         basis = fem.FacetBasis(space.mesh, space.element_u, facets=facets, intorder=space.intorder)
         nb = basis.Nbfun
@@ -155,7 +206,8 @@ class FollowerPressure(Term):
 
     def element_terms(self, u: np.ndarray, t: float, tangent: bool):
         """Residual contributions (nf, nb*d) and load stiffness (nf, nb*d, nb*d) or None."""
-        p = float(self.pressure(t))
+        p = float(evaluated_load(self.pressure(t), self.name, self.source, t, shape=(),
+                                 where=f"on {self.n_facets} facet(s)"))
         d = self.dim
         nf, nqp, nb = self.N.shape
         u_elem = u[self.element_dofs].reshape(nf, nb, d)

@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike
 
 from ..kinematics import Array, as_tensor_field, determinant, right_cauchy_green
 
-__all__ = ["Hyperelastic", "VolumetricEnergy", "check_positive", "check_nonnegative", "check_scalar"]
+__all__ = ["Hyperelastic", "VolumetricEnergy", "check_positive", "check_nonnegative", "check_scalar", "check_array"]
 
 
 def _first_index(mask: Array) -> tuple[int, ...]:
@@ -58,6 +58,33 @@ def check_scalar(name: str, value: float) -> float:
             return check_scalar(name, value.item())
         raise TypeError(f"parameter {name} must be a real number; got {value!r} of type {type(value).__name__}")
     return float(value)
+
+
+def check_array(name: str, value: ArrayLike, finite: bool = True) -> np.ndarray:
+    """Return ``value`` as a float array: a real number or a regular (nested) sequence or array of real numbers.
+
+    ``TypeError`` naming the parameter for strings, ``None``, booleans, complex numbers or other objects (also as
+    entries of a sequence); ``ValueError`` for a ragged sequence and, when ``finite``, for NaN or infinite entries.
+    The array counterpart of :func:`check_scalar`, for parameters given per point or per direction.
+    """
+    if value is None or isinstance(value, (str, bytes)):
+        raise TypeError(f"parameter {name} must be a number or an array of numbers; got {value!r}")
+    try:
+        array = np.asarray(value)
+    except ValueError:  # a ragged sequence
+        raise ValueError(f"parameter {name} must be a number or a regular array of numbers; got {value!r}") from None
+    if array.dtype == object:
+        for index in np.ndindex(array.shape):
+            check_scalar(f"{name}{list(index) if index else ''}", array[index])
+    elif array.dtype.kind not in "iuf":
+        raise TypeError(f"parameter {name} must be a number or an array of real numbers; got {value!r} "
+                        f"(dtype {array.dtype})")
+    array = array.astype(float)
+    if finite and not np.all(np.isfinite(array)):
+        index = _first_index(~np.isfinite(array))
+        raise ValueError(f"parameter {name} must be finite; got {float(array[index])!r}"
+                         f"{f' at index {list(index)}' if index else ''}")
+    return array
 
 
 def check_positive(name: str, value: float) -> float:
