@@ -37,6 +37,7 @@ from numpy.typing import ArrayLike
 from scipy.optimize import brentq
 
 from ..kinematics import Array
+from ..materials.base import check_array
 
 __all__ = ["HomogeneousResponse", "uniaxial", "equibiaxial", "biaxial"]
 
@@ -125,7 +126,7 @@ def _assemble(stretch_list: list[Array], stress_list: list[Array], shape: tuple[
 
 
 def _positive_stretches(name: str, value: ArrayLike) -> Array:
-    value = np.asarray(value, dtype=float)
+    value = check_array(name, value, finite=False)  # TypeError naming the parameter for strings, None, ...
     if not np.all(np.isfinite(value)) or np.any(value <= 0.0):
         raise ValueError(f"{name} must be positive and finite; got {value!r}")
     return value

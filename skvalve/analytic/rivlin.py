@@ -58,6 +58,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq
 
+from ..materials.base import check_array, check_scalar
+
 __all__ = ["BendingSolution", "bend", "moment_curvature", "plane_strain_energy"]
 
 Array = NDArray[np.float64]
@@ -90,7 +92,10 @@ def _check_layers(layers: Sequence) -> tuple[Array, tuple]:
             h, material = item
         except (TypeError, ValueError):
             raise ValueError(f"bend: layers[{i}] must be a (thickness, material) pair; got {item!r}") from None
-        h = float(h)
+        try:
+            h = check_scalar(f"layers[{i}] thickness", h)
+        except TypeError as err:
+            raise TypeError(f"bend: {err}") from None
         if not (np.isfinite(h) and h > 0.0):
             raise ValueError(f"bend: layers[{i}] thickness must be positive and finite; got {h!r}")
         if not (hasattr(material, "psi") and hasattr(material, "pk1")):
@@ -210,7 +215,10 @@ def bend(layers: Sequence[tuple[float, object]], a: float) -> BendingSolution:
     stretches the top face, ``a < 0`` the bottom face. Returns a :class:`BendingSolution`.
     """
     thicknesses, materials = _check_layers(layers)
-    a = float(a)
+    try:
+        a = check_scalar("a (the curvature change)", a)
+    except TypeError as err:
+        raise TypeError(f"bend: {err}") from None
     if not np.isfinite(a) or a == 0.0:
         raise ValueError(f"bend: curvature a must be finite and non-zero; got {a!r}")
     interfaces = np.concatenate([[0.0], np.cumsum(thicknesses)])
@@ -234,7 +242,10 @@ def bend(layers: Sequence[tuple[float, object]], a: float) -> BendingSolution:
 
 def moment_curvature(layers: Sequence[tuple[float, object]], curvatures: ArrayLike) -> Array:
     """Moment per unit width M(Δκ) for each curvature change (M = 0 at Δκ = 0)."""
-    curvatures = np.asarray(curvatures, dtype=float)
+    try:
+        curvatures = check_array("curvatures", curvatures)
+    except (TypeError, ValueError) as err:
+        raise type(err)(f"moment_curvature: {err}") from None
     _check_layers(layers)
     out = np.zeros(curvatures.shape)
     for idx, kappa in np.ndenumerate(curvatures):

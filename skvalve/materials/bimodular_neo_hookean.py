@@ -48,7 +48,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..kinematics import Array
-from .base import check_nonnegative, check_positive
+from .base import check_array, check_nonnegative, check_positive
 from .derivatives import InvariantDerivatives
 from .incompressible_neo_hookean import IncompressibleNeoHookean
 from .isotropic import IsotropicInvariantLaw, Partials, outer
@@ -57,8 +57,9 @@ __all__ = ["BimodularNeoHookean", "normalised_direction"]
 
 
 def normalised_direction(direction: ArrayLike, name: str = "direction") -> Array:
-    """Unit vectors of shape ``(3, *batch)`` or ``ValueError`` for bad shape, NaN or zero vectors."""
-    a = np.array(direction, dtype=float)
+    """Unit vectors of shape ``(3, *batch)``; ``ValueError`` for bad shape, NaN or zero vectors, ``TypeError`` for
+    anything but numbers (strings, None, ...)."""
+    a = check_array(name, direction, finite=False)  # TypeError naming the parameter for strings, None, ...
     if a.ndim < 1 or a.shape[0] != 3:
         raise ValueError(f"parameter {name} must have shape (3,) or (3, *batch); got {a.shape}")
     if not np.all(np.isfinite(a)):

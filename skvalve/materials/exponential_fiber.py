@@ -38,7 +38,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike
 
-from .base import check_nonnegative, check_positive
+from .base import check_array, check_nonnegative, check_positive
 
 _COMPRESSION_MODES = ("paper", "buckle")
 
@@ -111,7 +111,10 @@ class ExponentialFiber:
         )
 
     def _checked(self, stretch: ArrayLike) -> np.ndarray:
-        lam = np.asarray(stretch, dtype=float)
+        try:
+            lam = check_array("stretch", stretch, finite=False)
+        except (TypeError, ValueError) as err:
+            raise type(err)(f"ExponentialFiber: {err}") from None
         if not np.all(np.isfinite(lam)) or np.any(lam <= 0.0):
             bad = np.atleast_1d(lam)[~(np.isfinite(np.atleast_1d(lam)) & (np.atleast_1d(lam) > 0.0))][0]
             raise ValueError(f"ExponentialFiber: stretch must be finite and > 0; got {float(bad)!r}")

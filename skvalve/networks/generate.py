@@ -35,6 +35,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import Delaunay
 
+from skvalve.materials.base import check_scalar
 from skvalve.networks.network import INTERIOR, Network
 from skvalve.networks.orientation import network_alpha_mu
 
@@ -184,6 +185,11 @@ def generate(
     The result satisfies ``abs(α − alpha) ≤ alpha_tol`` and, for alpha ≥ 10, ``abs(μ − mu) ≤ mu_tol``
     (axially, modulo 180°); RuntimeError if ``max_attempts`` sub-seeds all fail.
     """
+    for name, value in (("alpha", alpha), ("mu", mu), ("alpha_tol", alpha_tol), ("mu_tol", mu_tol)):
+        try:
+            check_scalar(name, value)
+        except TypeError as err:
+            raise TypeError(f"generate: {err}") from None
     if not (0.0 <= alpha < 95.0):
         raise ValueError(f"generate: alpha must be in [0, 95) percent, got {alpha}")
     if not np.isfinite(mu):
