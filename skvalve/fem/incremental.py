@@ -17,14 +17,15 @@ The stationarity of :math:`E` is implicit Euler. Each iteration solves
 
     \big(\mathcal P[K] + M/h^2\big)\,p = -\nabla E
 
-with :math:`\mathcal P[K]` the tangent whose element blocks (and each contact stencil, ``Contribution.projected_matrix``)
-are projected onto their positive semidefinite parts (projected Newton: Teran et al. 2005), so :math:`p` is a descent
-direction; once the relative residual is below ``newton_below`` the unprojected tangent is used (Newton's quadratic
-rate), falling back to the projected one when its step is not a descent direction. The step length starts at the
-terms' cap (:meth:`~skvalve.fem.problem.Problem.step_fraction`: 0.9 of the collision-free share for a barrier, so no
-iterate intersects) and is halved until the Armijo condition :math:`E(u + \alpha p) \le E(u) + c\,\alpha\,\nabla E\cdot p`
-holds. Where a term has no potential (a follower pressure on an open surface is not conservative) the merit is the
-residual norm instead (``energy_merit`` False in the history): the line search then asks that :math:`|\nabla E|` falls.
+with :math:`\mathcal P[K]` the tangent whose element blocks (and each contact stencil,
+``Contribution.projected_matrix``) are projected onto their positive semidefinite parts (projected Newton: Teran et
+al. 2005), so :math:`p` is a descent direction; once the relative residual is below ``newton_below`` the unprojected
+tangent is used (Newton's quadratic rate), falling back to the projected one when its step is not a descent
+direction. The step length starts at the terms' cap (:meth:`~skvalve.fem.problem.Problem.step_fraction`: 0.9 of the
+collision-free share for a barrier, so no iterate intersects) and is halved until the Armijo condition
+:math:`E(u + \alpha p) \le E(u) + c\,\alpha\,\nabla E\cdot p` holds. Where a term has no potential (a follower
+pressure on an open surface is not conservative) the merit is the residual norm instead (``energy_merit`` False in the
+history): the line search then asks that :math:`|\nabla E|` falls.
 Converged: :math:`\lVert \nabla E_f\rVert \le \max(\text{rtol}\,f_\text{ref}, \text{atol})` (Newton's measure).
 """
 
@@ -187,17 +188,19 @@ def _minimise(problem: Problem, u_old, t_old: float, t_new: float, predictor, in
     if problem.step_fraction(u_old, t_old, u, t_new) < 1.0:
         raise _StepFailed(f"the prescribed motion from load factor {t_old:.6g} to {t_new:.6g} is not collision-free")
 
-    def merit(state: np.ndarray, gradient: np.ndarray) -> float:
-        energy = problem.energy(state, t_new)
-        if energy is None:
-            return float(np.linalg.norm(gradient[free]))
-        d = state - predictor
-        return energy + 0.5 * float(d @ (inertia * d))
-
     residual, tangent = problem.assemble(u, t_new, tangent=True, step=step)
     gradient = residual + inertia * (u - predictor)
+    energy_merit = problem.energy(u, t_new) is not None  # else the residual norm (module docstring)
+
+    def merit(state: np.ndarray, gradient: np.ndarray) -> float:
+        """The incremental potential at ``state``, or the norm of its gradient where a term has no potential."""
+        if not energy_merit:
+            return float(np.linalg.norm(gradient[free]))
+        d = state - predictor
+        energy = problem.energy(state, t_new)
+        return float("inf") if energy is None else energy + 0.5 * float(d @ (inertia * d))
+
     value = merit(u, gradient)
-    energy_merit = problem.energy(u, t_new) is not None
     history = []
     for iteration in range(1, opts.max_iter + 1):
         reference = reference_force(problem, residual, fixed)
