@@ -224,6 +224,10 @@ class IPCContact(Term):
             self._built_for = V.copy()
         return self.collisions
 
+    def forget_collisions(self) -> None:
+        """Drop the collision set kept for the last state (the next evaluation builds it again)."""
+        self._built_for = None
+
     def positions(self, u: np.ndarray, t: float) -> np.ndarray:
         """Collision-mesh vertex positions (n, 3): the body's surface at ``u``, the obstacles at ``t``."""
         V = self.rest.copy()

@@ -1,0 +1,88 @@
+"""Benchmark: IPC barrier contact (:class:`skvalve.fem.contact.IPCContact`, ipctk) on the Texas TriValve 1.0 diseased
+valve's whole hex boundary, against the penalty contact the held valve converged with, in the same run.
+
+Times, best of ``--repeats``: the term's set-up (collision mesh, filters), the collision set's build, the barrier's
+assembly at a new state (build, gradient, exact and per-stencil PSD Hessians), the collision-free step of a random
+move of every surface vertex (``--move`` mm, continuous collision detection), an intersection check, and the penalty
+term's assembly with tangent (:class:`~skvalve.fem.contact.SurfaceContact`, blended, search depth 0.2 mm, barrier,
+loaded skins). ``--state FILE``: a kept closure state instead of the open valve. Needs the shipped input
+(``$SKVALVE_TRIVALVE``, Mathur et al. 2022, CC BY-NC-SA 4.0); exits 2 without it.
+
+Last line: ``ipc_assembly_ratio=<IPC assembly time / penalty assembly time>``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+from assembly import best_of  # benchmarks/ is on the path when a script in it runs
+
+from skvalve.fem.contact import IPCContact
+from skvalve.io.abaqus import read_model, trivalve_input
+from skvalve.papers.mathur2022.reproduce import KEPT_STATE_OPTIONS, read_kept_state
+from skvalve.valve.closure import ClosureOptions, closure_setup
+from skvalve.valve.model import valve_model
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--state", type=Path, default=None, help="a kept closure state (t, u) to measure at")
+    parser.add_argument("--dhat", type=float, default=0.1, help="barrier range (mm)")
+    parser.add_argument("--stiffness", type=float, default=100.0, help="barrier stiffness (kPa)")
+    parser.add_argument("--move", type=float, default=0.3, help="random move of every surface vertex (mm)")
+    parser.add_argument("--repeats", type=int, default=3)
+    args = parser.parse_args()
+    path = trivalve_input()
+    if path is None:
+        print("Texas TriValve input not found: set $SKVALVE_TRIVALVE (Mathur et al. 2022, CC BY-NC-SA 4.0)")
+        return 2
+    print(f"machine: {os.cpu_count()} cores, load {os.getloadavg()[0]:.2f}", flush=True)
+    model = valve_model(read_model(path))
+    options = ClosureOptions.for_relaxation(model, **KEPT_STATE_OPTIONS)
+    setup = closure_setup(options=options, model=model)
+    space = setup.problem.space
+    if args.state is None:
+        u, t = np.zeros(space.n_dofs), options.end
+    else:
+        state = read_kept_state(args.state)
+        u, t = state.u, state.t
+    clock = time.perf_counter()
+    ipc = IPCContact(space, dhat=args.dhat, stiffness=args.stiffness)
+    set_up = time.perf_counter() - clock
+    V = ipc.positions(u, t)
+    print(f"collision mesh: {ipc.n_body} surface vertices, {ipc.mesh.num_faces} triangles, {ipc.mesh.num_edges} "
+          f"edges; set-up {set_up:.3f} s", flush=True)
+    rng = np.random.default_rng(0)
+    moved = u.copy()
+    moved[: space.n_u].reshape(-1, 3)[ipc.nodes] += args.move * rng.uniform(-1.0, 1.0, (ipc.n_body, 3))
+
+    def build() -> None:
+        ipc.collisions.build(ipc.mesh, V, ipc.dhat)
+
+    def assemble() -> None:  # at a new state, as in a solve: the collision set is built again
+        ipc.forget_collisions()
+        ipc.assemble(u, t, True, None)
+
+    timings = {
+        "collision build": best_of(build, args.repeats),
+        "IPC assembly (build, gradient, both Hessians)": best_of(assemble, args.repeats),
+        f"CCD step fraction ({args.move:g} mm move)": best_of(lambda: ipc.step_fraction(u, t, moved, t), args.repeats),
+        "has_intersections": best_of(lambda: ipc.intersects(u, t), args.repeats),
+        "penalty assembly with tangent": best_of(lambda: setup.contact.assemble(u, t, True, None), args.repeats),
+    }
+    pairs = ipc.active_pairs(u, t)
+    for label, seconds in timings.items():
+        print(f"{label:48s} {seconds:8.3f} s", flush=True)
+    print(f"IPC pairs within dhat {args.dhat:g} mm: {pairs}; collision-free share of the move: "
+          f"{ipc.step_fraction(u, t, moved, t):.3f}; intersecting: {ipc.intersects(u, t)}")
+    ratio = timings["IPC assembly (build, gradient, both Hessians)"] / timings["penalty assembly with tangent"]
+    print(f"ipc_assembly_ratio={ratio:.3f}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
