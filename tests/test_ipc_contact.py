@@ -280,3 +280,51 @@ def test_plane_barrier_matches_ipctk_where_ipctk_builds_plane_pairs():
     assert ours.energy(u, 0.0) == pytest.approx(barrier(collisions, reference, V), rel=1e-12)
     gradient = ours.assemble(u, 0.0, False, None).internal[: space.n_u].reshape(-1, 3)[ours.nodes]
     assert gradient.ravel() == pytest.approx(barrier.gradient(collisions, reference, V), rel=1e-10, abs=1e-12)
+
+
+def _cylinder_on_plane(divisions: int):
+    """A plane-strain block with a parabolic base z = x^2 / 2R (R = 1) pressed 0.004 onto a plane: the contact width
+    and the line load, for Hertz's half-width b = sqrt(4 F R / (pi E*))."""
+    radius, half, height, depth = 1.0, 0.4, 0.4, 0.05
+    mesh = box((divisions, 1, divisions // 4), (2 * half, depth, height)).translated([-half, 0.0, 0.0])
+    x, y, z = mesh.p
+    mesh = skfem.MeshHex(np.vstack([x, y, z + (1.0 - z / height) * x ** 2 / (2.0 * radius)]), mesh.t)
+    solid = Solid(mesh, MATERIAL)
+    solid.add_dirichlet(lambda X: np.ones(X.shape[1], dtype=bool), 0.0, components=[1])  # plane strain
+    top = lambda X: np.isclose(X[2], height)
+    solid.add_dirichlet(top, np.array([0.0, -0.004]), components=[0, 2])
+    contact = IPCContact(solid.space, dhat=5e-4, stiffness=200.0, planes=[Plane([0, 0, -4e-4], [0, 0, 1])])
+    contact.supports = True
+    solid.add_term(contact)
+    result = solve(solid, steps=4, rtol=1e-8, atol=1e-10, max_iter=60, progress=False)
+    load = -result.reaction(top)[2] / depth
+    E = 2.0 * 10.0 * 1.3
+    half_width = np.sqrt(4.0 * load * radius / (np.pi * E / (1.0 - 0.3 ** 2)))
+    return contact.contact_area(result.solutions[-1], 1.0) / depth, 2.0 * half_width, 2.0 * half / divisions
+
+
+def test_contact_width_of_a_cylinder_on_a_plane_converges_to_hertz():
+    """Measured: width / 2b = 0.72, 0.90, 0.99 for element sizes 0.02, 0.01, 0.005 (the contact area counts faces
+    all of whose nodes touch, so it misses up to about one element at each edge of the strip)."""
+    errors = []
+    for divisions in (80, 160):
+        width, hertz, size = _cylinder_on_plane(divisions)
+        assert abs(width - hertz) <= 1.5 * size
+        errors.append(abs(width - hertz))
+    assert errors[1] < 0.5 * errors[0]
+    assert width == pytest.approx(hertz, rel=0.05)
+
+
+def test_suggested_stiffness_balances_the_elastic_gradient():
+    """IPC's initial stiffness: -g_E.g_B / |g_B|^2 (g_B the barrier gradient at unit stiffness) where that exceeds
+    IPC's floor; the floor itself for small elastic gradients."""
+    _, contact, _ = _block_over_obstacle(drop=0.0, gap=0.01, dhat=0.02)
+    space = contact.space
+    u = np.zeros(space.n_dofs)
+    unit = IPCContact(space, dhat=0.02, stiffness=1.0, obstacles=contact.obstacles).assemble(u, 0.0, False, None)
+    g = np.zeros(space.n_dofs)
+    g[2::3] = 1e4
+    kappa, largest = contact.suggest_stiffness(g, u, 0.0)
+    assert kappa == pytest.approx(-(g @ unit.internal) / (unit.internal @ unit.internal), rel=1e-9)
+    floor, _ = contact.suggest_stiffness(1e-3 * g, u, 0.0)
+    assert 0.0 < floor < kappa < largest

@@ -244,6 +244,7 @@ class IPCContact(Term):
         self._collisions_at(V)
         unit = ipctk.BarrierPotential(self.dhat, 1.0, True)
         grad_barrier = unit.gradient(self.collisions, self.mesh, V)
+        grad_barrier[3 * self.n_body:] = 0.0  # obstacle vertices are no unknowns: their reactions must not count
         grad_energy = self._select.T @ np.asarray(elastic_gradient, dtype=float)
         return tuple(float(v) for v in ipctk.initial_barrier_stiffness(
             self.diagonal, unit.barrier, self.dhat, average_mass, grad_energy, grad_barrier))
