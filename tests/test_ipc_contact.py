@@ -328,3 +328,22 @@ def test_suggested_stiffness_balances_the_elastic_gradient():
     assert kappa == pytest.approx(-(g @ unit.internal) / (unit.internal @ unit.internal), rel=1e-9)
     floor, _ = contact.suggest_stiffness(1e-3 * g, u, 0.0)
     assert 0.0 < floor < kappa < largest
+
+
+@pytest.mark.parametrize("velocity", [False, True])
+def test_incremental_step_with_mass_is_implicit_euler(velocity):
+    """With a mass M and time step h each step's state satisfies R(u) + M (u - u~) / h^2 = 0 on the free dofs, with
+    u~ = u_n (pseudo-mass) or u_n + h v_n (inertia, v_n = (u_n - u_{n-1}) / h): the stationarity of the step's
+    incremental potential, checked from the residual the problem assembles afterwards."""
+    solid, contact, _ = _block_over_obstacle(drop=0.1, gap=0.05, dhat=0.02, rollers=True)
+    h = 0.5
+    mass = np.full(solid.space.n_dofs, 3.0)
+    result = incremental_potential(solid, steps=3, mass=mass, time_step=h, velocity=velocity,
+                                   options=IncrementalOptions(rtol=1e-11, atol=1e-13), progress=False)
+    u0, u1, u2 = result.solutions[-3:]
+    predictor = u1 + (u1 - u0 if velocity else 0.0)
+    residual, _ = solid.assemble(u2, 1.0, tangent=False)
+    free = solid.pattern.free
+    balance = residual[free] + mass[free] * (u2 - predictor)[free] / h ** 2
+    assert np.linalg.norm(balance) <= 1e-9 * np.linalg.norm(residual[free])
+    assert np.linalg.norm(residual[free]) > 1e-6  # the inertia carries part of the load: not the static state
