@@ -1,7 +1,7 @@
 """Figures 5–7 of thomas2019 from the FE² protocol runs (matplotlib, imported by the caller on demand).
 
 * :func:`figure_5b` — edge tension against edge stretch, both axes, the five protocols (Fig. 5b).
-* :func:`figure_5_contours` — E11, E22, S11, S22 on the deformed top surface (Fig. 5c–f).
+* :func:`figure_5_contours` — E11, E22, S11, S22 on the deformed top surface (Fig. 5c–f), tines as dots.
 * :func:`figure_6` — orientation (before/after) and fiber-strain histograms of N1, N2, N3 (Fig. 6).
 * :func:`figure_7` — max principal strain E1 of the elements against the fiber strains (Fig. 7).
 """
@@ -65,19 +65,27 @@ def figure_5_contours(run: ProtocolRun):
     E = fields.element_average("green_strain")
     S = fields.element_average("cauchy") / 1e3
     polygons, elements = _top_faces(run)
+    mesh = run.solid.mesh
+    tine_sets = [nodes for name, nodes in run.grips.nodes.items() if run.grips.positions[name].size]
+    held = np.unique(np.concatenate(tine_sets)) if tine_sets else np.zeros(0, dtype=int)
+    held = held[np.isclose(mesh.p[2, held], mesh.p[2].max())]
+    tines = (mesh.p[:2, held] + run.u[: run.solid.space.n_u].reshape(-1, 3)[held, :2].T) * 1e3
     fig, axes = plt.subplots(2, 2, figsize=(8.0, 7.0))
     for ax, (title, values) in zip(axes.ravel(), (("(c) E11", E[:, 0, 0]), ("(d) E22", E[:, 1, 1]),
                                                    ("(e) S11 (kPa)", S[:, 0, 0]), ("(f) S22 (kPa)", S[:, 1, 1])),
                                    strict=True):
         collection = PolyCollection(polygons, array=values[elements], cmap="jet", edgecolors="none")
         ax.add_collection(collection)
+        if tines.size:
+            ax.plot(tines[0], tines[1], "ko", ms=3)
         ax.autoscale()
         ax.set_aspect("equal")
         ax.set_title(title)
         ax.set_xlabel("x (mm)")
         ax.set_ylabel("y (mm)")
         fig.colorbar(collection, ax=ax)
-    fig.suptitle(f"Fig. 5c–f: protocol {run.ratio[0]:g}:{run.ratio[1]:g}, deformed top surface")
+    fig.suptitle(f"Fig. 5c–f: protocol {run.ratio[0]:g}:{run.ratio[1]:g}, {run.grips.attachment.label}, "
+                 "deformed top surface")
     return fig
 
 

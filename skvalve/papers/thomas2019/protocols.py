@@ -1,10 +1,11 @@
-r"""The five biaxial protocols (§2.5): edge displacements found so that the edge tensions hit the targets.
+r"""The five biaxial protocols (§2.5): grip displacements found so that the edge tensions hit the targets.
 
 The paper drove each edge with the actuator displacement recorded at each tension (not published). Here
-the intent is reproduced: the four edge faces move along their normals, symmetrically
-(:math:`u_x = \mp\delta_x/2` on left/right, :math:`u_y = \mp\delta_y/2` on bottom/top, free tangentially
-and through the thickness, one node pinned in z), and the final sizes :math:`(\delta_x, \delta_y)` are
-found so that the membrane tensions — the summed edge reactions per unit *reference* edge length (N/m),
+the intent is reproduced: the grips of each edge (:mod:`.attachments`: the whole edge face, or the tines)
+move along the edge normal, symmetrically (:math:`u_x = \mp\delta_x/2` on left/right,
+:math:`u_y = \mp\delta_y/2` on bottom/top; free tangentially unless the tines are pinned, free through
+the thickness, one node pinned in z), and the final sizes :math:`(\delta_x, \delta_y)` are found so that
+the membrane tensions — the summed grip reactions per unit *reference* edge length (N/m),
 :math:`T_1 = R_x^\text{right}/H`, :math:`T_2 = R_y^\text{top}/W` — reach the protocol's targets
 (circumferential : radial = a : b, the larger one 40 N/m):
 
@@ -15,8 +16,8 @@ found so that the membrane tensions — the summed edge reactions per unit *refe
    the converged state, started from the homogeneous model's condensed stiffness
    :math:`J = \partial T/\partial\delta`, until :math:`\max|T - T^*| \le` ``tolerance`` × 40 N/m.
 
-Clamped straight edges (rather than hooks) make the corners stiffer than the centre; that is what the
-paper's displacement boundary conditions do too.
+With uniform edges the corners are the stiffest places (both edges pull there); with tines the corners
+are free and unloaded, and the stress concentrates at the tines.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from ...fem import Solid, solve
 from ...multiscale.homogeneous import HomogeneousBiaxial
 from ...multiscale.material import RVEMaterial
 from . import data
+from .attachments import UNIFORM_EDGES, Attachment, Grips, grips_of
 from .sample import Sample
 
 __all__ = ["EdgeSchedule", "ProtocolRun", "biaxial_problem", "edge_tensions", "run_protocol", "targets"]
@@ -71,27 +73,27 @@ class EdgeSchedule:
         return value
 
 
-def biaxial_problem(sample: Sample, material: RVEMaterial) -> tuple[Solid, EdgeSchedule]:
-    """The sample with edge displacements δ(t) on its four edge faces and one node pinned in z."""
-    mesh = sample.mesh
-    solid = Solid(mesh, material)
+def biaxial_problem(sample: Sample, material: RVEMaterial,
+                    attachment: Attachment = UNIFORM_EDGES) -> tuple[Solid, EdgeSchedule, Grips]:
+    """The sample held by ``attachment``, its grips moved by δ(t) along the edge normals, one node pinned in z."""
+    solid = Solid(sample.mesh, material)
     schedule = EdgeSchedule()
+    grips = grips_of(solid, attachment, sample.size)
     for name, axis, sign in (("left", 0, -1.0), ("right", 0, 1.0), ("bottom", 1, -1.0), ("top", 1, 1.0)):
-        solid.add_dirichlet(name, schedule.edge_value(axis, sign), components=[axis])
+        solid.add_dirichlet(nodes=grips.nodes[name], value=schedule.edge_value(axis, sign), components=[axis])
+        if grips.pinned:
+            solid.add_dirichlet(nodes=grips.nodes[name], value=0.0, components=[1 - axis])
     width, height, _ = sample.size
     X = solid.space.dof_coordinates
     centre = int(np.argmin((X[0] - width / 2) ** 2 + (X[1] - height / 2) ** 2 + X[2] ** 2))
     solid.add_dirichlet(nodes=[centre], value=0.0, components=[2])
-    return solid, schedule
+    return solid, schedule, grips
 
 
-def edge_tensions(solid: Solid, residual: np.ndarray, sample: Sample) -> np.ndarray:
-    """(T1, T2) in N/m: right-edge x reaction / H and top-edge y reaction / W (reference lengths)."""
-    space = solid.space
+def edge_tensions(solid: Solid, residual: np.ndarray, sample: Sample, grips: Grips) -> np.ndarray:
+    """(T1, T2) in N/m: right grips' x reaction / H and top grips' y reaction / W (reference lengths)."""
     width, height, _ = sample.size
-    right = residual[space.displacement_dofs(space.scalar_dofs_on("right"), [0])].sum()
-    top = residual[space.displacement_dofs(space.scalar_dofs_on("top"), [1])].sum()
-    return np.array([right / height, top / width])
+    return grips.tensions(solid, residual, width, height)
 
 
 @dataclass
@@ -110,6 +112,7 @@ class ProtocolRun:
     timings: dict  # solver wall time: assembly (RVE solves included), sparse solves, set-up
     solid: Solid = field(repr=False)
     material: RVEMaterial = field(repr=False)
+    grips: Grips = field(repr=False)
 
     @property
     def tension_error(self) -> float:
@@ -136,10 +139,10 @@ def _homogeneous_guess(sample: Sample, material: RVEMaterial, goal: np.ndarray, 
 def run_protocol(sample: Sample, material: RVEMaterial, ratio: tuple[float, float],
                  max_tension: float = data.MAX_TENSION_N_PER_M, steps: int = 6, tolerance: float = 0.01,
                  max_corrections: int = 6, callbacks: Sequence = (), progress: bool = False,
-                 rtol: float = 1e-8) -> ProtocolRun:
-    """Solve one protocol on ``sample`` with a fresh (or reference-state) ``material`` (module docstring)."""
+                 rtol: float = 1e-8, attachment: Attachment = UNIFORM_EDGES) -> ProtocolRun:
+    """Solve one protocol on ``sample`` held by ``attachment`` with a fresh (or reference-state) ``material``."""
     goal = targets(ratio, max_tension)
-    solid, schedule = biaxial_problem(sample, material)
+    solid, schedule, grips = biaxial_problem(sample, material, attachment)
     delta, jacobian = _homogeneous_guess(sample, material, goal)
     width, height, _ = sample.size
     lengths = np.array([width, height])
@@ -148,7 +151,7 @@ def run_protocol(sample: Sample, material: RVEMaterial, ratio: tuple[float, floa
     def record(event):
         if event.step > 0:
             stretches.append(1.0 + schedule(event.load_factor) / lengths)
-            tensions.append(edge_tensions(solid, event.result.residuals[-1], sample))
+            tensions.append(edge_tensions(solid, event.result.residuals[-1], sample, grips))
 
     schedule.add(1.0, delta)
     result = solve(solid, steps=steps, progress=progress, rtol=rtol, callbacks=[record, *callbacks])
@@ -173,4 +176,4 @@ def run_protocol(sample: Sample, material: RVEMaterial, ratio: tuple[float, floa
         change = tensions[-1] - before  # Broyden's rank-one update of dT/dδ
         jacobian = jacobian + np.outer(change - jacobian @ step, step) / (step @ step)
     return ProtocolRun(tuple(ratio), goal, delta, np.array(stretches), np.array(tensions), u, t, corrections,
-                       iterations, timings, solid, material)
+                       iterations, timings, solid, material, grips)
