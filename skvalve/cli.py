@@ -1,4 +1,4 @@
-"""Command-line interface: ``skvalve materials``, ``skvalve reproduce <paper>``, ``skvalve valve info FILE``.
+"""Command-line interface: ``skvalve materials``, ``skvalve reproduce <paper>``, ``skvalve valve info|close FILE``.
 
 Exit codes: 0 done; 1 ``--strict`` and a row is a regression or an unexplained disagreement; 2 bad
 arguments, an unusable ``--out``, a paper not available yet, its input data not found (a
@@ -144,6 +144,38 @@ def _cmd_valve_info(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_valve_close(args: argparse.Namespace) -> int:
+    path = Path(args.file)
+    if not path.is_file():
+        return _error(f"valve close: {path} is not a file (give an Abaqus .inp, e.g. "
+                      "../shared/data/texas_trivalve/Diseased_QuasiStatic.inp)")
+    out = Path(args.out)
+    if problem := check_out(out):
+        return _error(problem)
+    from .io.abaqus import AbaqusParseError
+    from .valve.options import CloseOptions
+    from .valve.run import ClosureFailed, close_valve
+    from .valve.state import StateError
+    from .valve.support import UnsupportedInputError
+
+    options = CloseOptions(end=args.end)
+    try:
+        report = close_valve(path, options, out=out, resume=args.resume, progress=not args.quiet)
+    except (AbaqusParseError, UnsupportedInputError, StateError) as err:
+        return _error(f"valve close: {err}")
+    except ClosureFailed as err:
+        print(f"skvalve: valve close: {err}\nThe last accepted state is kept in {out / 'state.npz'}.",
+              file=sys.stderr)
+        return EXIT_STRICT
+    except KeyboardInterrupt:
+        print(f"\nskvalve: valve close interrupted; resume with: skvalve valve close {path} --out {out} --resume",
+              file=sys.stderr)
+        return EXIT_INTERRUPTED
+    print(report.summary())
+    print(f"wrote {out / 'state.npz'}, {out / 'closure.log'}, {out / 'closure.pvd'}")
+    return 0 if report.converged else EXIT_STRICT
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="skvalve", description=__doc__.split("\n")[0])
     parser.add_argument("--version", action="version", version=f"skvalve {__version__}")
@@ -174,6 +206,16 @@ def build_parser() -> argparse.ArgumentParser:
     info.add_argument("file", help="Abaqus input (.inp), e.g. a Texas TriValve model")
     info.add_argument("--out", default="skvalve_out/valve_info", help="folder for summary.txt and undeformed.png")
     info.set_defaults(func=_cmd_valve_info)
+    close = valve_sub.add_parser("close", help="close a valve: open configuration to the converged end-systolic state",
+                                 description="Close a Texas TriValve input with the defaults of skvalve.valve.options "
+                                             "(IPC contact, incremental-potential steps, the held load solved to 1e-6).")
+    close.add_argument("file", help="Abaqus input (.inp), e.g. ../shared/data/texas_trivalve/Diseased_QuasiStatic.inp")
+    close.add_argument("--out", default="skvalve_out/valve_close",
+                       help="folder for state.npz (kept after every step), closure.log and closure.pvd")
+    close.add_argument("--resume", action="store_true", help="continue from --out/state.npz (its own options)")
+    close.add_argument("--end", type=float, default=None, help="last step time (default: the input's step time)")
+    close.add_argument("--quiet", action="store_true", help="no progress bar")
+    close.set_defaults(func=_cmd_valve_close)
     return parser
 
 

@@ -27,7 +27,7 @@ def project_psd(matrices: np.ndarray) -> np.ndarray:
     values, vectors = np.linalg.eigh(symmetric)
     if np.all(values >= 0.0):
         return symmetric
-    return np.einsum("eik,ek,ejk->eij", vectors, np.maximum(values, 0.0), vectors, optimize=True)
+    return (vectors * np.maximum(values, 0.0)[..., None, :]) @ np.swapaxes(vectors, -1, -2)
 
 
 def shift_psd(matrices: np.ndarray) -> np.ndarray:

@@ -141,14 +141,18 @@ class ValveModel:
                 "pressure_facets": int(sum(p.facets.size for p in self.pressures)),
                 "links": self.links.size if self.links is not None else 0}
 
-    def submodel(self, regions: list[int]) -> ValveModel:
+    def submodel(self, regions: list[int], chordae: bool = False) -> ValveModel:
         """The leaflets of the given region numbers alone: their hexes, conditions and pressure, and the cables
-        whose two ends lie on them (cables to chordae-only nodes are dropped). For smoke tests and studies."""
+        whose two ends lie on them. ``chordae``: also the chordae trees that hold them (the cables between their
+        vertices and nodes of no hex, branch points and papillary tips, less the branches that lead to no kept
+        leaflet). For smoke tests and studies."""
         keep = np.isin(self.regions, regions)
         if not np.any(keep):
             raise ValueError(f"no hexes in regions {regions}; the model has regions 0..{len(self.region_names) - 1}")
         cells = self.mesh.t[:, keep]
         used = np.unique(cells)
+        if chordae:
+            used = np.union1d(used, self._holding_chordae_nodes(used))
         new = np.full(self.mesh.p.shape[1], -1)
         new[used] = np.arange(used.size)
         mesh = skfem.MeshHex(np.ascontiguousarray(self.mesh.p[:, used]), np.ascontiguousarray(new[cells]))
@@ -173,6 +177,29 @@ class ValveModel:
                           self.laws, chordae, conditions, pressures, self.end_time, self.vertex_source[used],
                           self.notes + [f"submodel of {names}: {int(inside.sum())} of {inside.size} cables kept"],
                           self.links.subset(new) if self.links is not None else None)
+
+    def _holding_chordae_nodes(self, leaflet_vertices: np.ndarray) -> np.ndarray:
+        """The nodes of no hex on the chordae that reach ``leaflet_vertices``: cables whose ends are leaflet vertices
+        or nodes of no hex, pruned of dangling branches (a free end of degree one), until none is left."""
+        n = self.mesh.p.shape[1]
+        in_hex = np.zeros(n, dtype=bool)
+        in_hex[self.mesh.t] = True
+        mine = np.zeros(n, dtype=bool)
+        mine[leaflet_vertices] = True
+        allowed = mine | ~in_hex
+        ends = self.chordae.ends[np.all(allowed[self.chordae.ends], axis=1)]
+        prescribed = np.zeros(n, dtype=bool)
+        for condition in self.conditions:
+            prescribed[condition.vertices] = True
+        while ends.size:
+            degree = np.bincount(ends.ravel(), minlength=n)
+            dangling = (degree == 1) & ~mine & ~prescribed
+            keep = ~np.any(dangling[ends], axis=1)
+            if keep.all():
+                break
+            ends = ends[keep]
+        nodes = np.unique(ends)
+        return nodes[~in_hex[nodes]]
 
     def problem(self, solid: str = "fbar", slack_fraction: float = 1e-6, transition: float = 0.01,
                 insertion: str = "node", compression: bool = False) -> Problem:

@@ -1,6 +1,6 @@
 r"""Closure outputs: the mathur2022 Table 2–3 measures of a state and a ParaView series with contact pressure.
 
-Measures of a state :math:`u` of a :class:`~skvalve.valve.closure.ClosureSetup` (units of the input: mm, MPa):
+Measures of a state :math:`u` of a :class:`~skvalve.valve.setup.ValveSetup` (units of the input: mm, MPa):
 
 * orifice and leaflet areas of :func:`skvalve.valve.geometry.valve_areas` (ventricular, mid and atrial
   surfaces), the leaflet centre regions chosen once on the reference configuration;
@@ -34,13 +34,14 @@ import meshio
 import numpy as np
 import scipy.sparse as sp
 
+from ..fem.contact import IPCContact
 from ..fem.fields import element_centres
 from ..fem.newton import StepEvent
 from ..io.abaqus.elements import is_shell_like
 from ..io.files import replace_atomically
-from .closure import ClosureSetup
 from .geometry import annulus_nodes, leaflet_surfaces, valve_areas
 from .model import ABAQUS_TO_SKFEM_HEX
+from .setup import ValveSetup
 from .surfaces import shell_stacks
 
 __all__ = ["ClosureMeasures", "closure_measures", "ClosureWriter", "abaqus_positions", "ShellMidsurface",
@@ -72,7 +73,7 @@ class ShellMidsurface:
     upper: np.ndarray
 
 
-def shell_midsurface(setup: ClosureSetup) -> ShellMidsurface:
+def shell_midsurface(setup: ValveSetup) -> ShellMidsurface:
     """The :class:`ShellMidsurface` of a setup's extruded shells (empty for bricks; module docstring).
 
     Raises ``ValueError`` if the vertices found do not average to the input's shell nodes in the reference
@@ -109,7 +110,7 @@ def shell_midsurface(setup: ClosureSetup) -> ShellMidsurface:
     return result
 
 
-def abaqus_positions(setup: ClosureSetup, u: np.ndarray) -> np.ndarray:
+def abaqus_positions(setup: ValveSetup, u: np.ndarray) -> np.ndarray:
     """Current coordinates of all the input's nodes (nodes outside the model stay where they are).
 
     Shell nodes follow the middle of their extruded fibre (:func:`shell_midsurface`).
@@ -124,14 +125,14 @@ def abaqus_positions(setup: ClosureSetup, u: np.ndarray) -> np.ndarray:
     return x
 
 
-def _vertex_of(setup: ClosureSetup) -> np.ndarray:
+def _vertex_of(setup: ValveSetup) -> np.ndarray:
     vertex_of = np.full(setup.abaqus.nodes.shape[0], -1, dtype=np.int64)
     source = setup.model.vertex_source
     vertex_of[source[source >= 0]] = np.flatnonzero(source >= 0)
     return vertex_of
 
 
-def _elements_with_faces(setup: ClosureSetup, faces: np.ndarray) -> np.ndarray:
+def _elements_with_faces(setup: ValveSetup, faces: np.ndarray) -> np.ndarray:
     """Mesh elements having all four vertices of one of ``faces`` (input node indices)."""
     mesh = setup.model.mesh
     vertices = _vertex_of(setup)[faces]
@@ -146,11 +147,11 @@ def _elements_with_faces(setup: ClosureSetup, faces: np.ndarray) -> np.ndarray:
 class _Reference:
     """Shell midsurface map, surfaces, annulus and centre regions of the reference configuration, once per setup."""
 
-    def __init__(self, setup: ClosureSetup) -> None:
+    def __init__(self, setup: ValveSetup) -> None:
         self.midsurface = shell_midsurface(setup)
         self._measured = False
 
-    def measure(self, setup: ClosureSetup) -> _Reference:
+    def measure(self, setup: ValveSetup) -> _Reference:
         """Surfaces, annulus and centre regions (on first use: :func:`abaqus_positions` needs only the map)."""
         if self._measured:
             return self
@@ -175,7 +176,7 @@ class _Reference:
 _REFERENCES: dict[int, tuple[weakref.ref, _Reference]] = {}
 
 
-def _reference(setup: ClosureSetup) -> _Reference:
+def _reference(setup: ValveSetup) -> _Reference:
     """The cached :class:`_Reference` of ``setup`` (keyed by identity, dropped when the setup is collected)."""
     key = id(setup)
     cached = _REFERENCES.get(key)
@@ -185,7 +186,7 @@ def _reference(setup: ClosureSetup) -> _Reference:
     return cached[1]
 
 
-def closure_measures(setup: ClosureSetup, u: np.ndarray, t: float = 1.5) -> ClosureMeasures:
+def closure_measures(setup: ValveSetup, u: np.ndarray, t: float = 1.5) -> ClosureMeasures:
     """Orifice, leaflet and coaptation areas and leaflet-centre stresses at state ``u`` (module docstring)."""
     reference = _reference(setup).measure(setup)
     x = abaqus_positions(setup, u)
@@ -197,16 +198,21 @@ def closure_measures(setup: ClosureSetup, u: np.ndarray, t: float = 1.5) -> Clos
     return ClosureMeasures(areas.orifice, leaflet_area, coaptation, centre, areas.leaflet)
 
 
-def max_principal_cauchy(setup: ClosureSetup, u: np.ndarray) -> np.ndarray:
+def max_principal_cauchy(setup: ValveSetup, u: np.ndarray) -> np.ndarray:
     """Maximum principal Cauchy stress at each hex centre (n_elements,)."""
     sigma = element_centres(setup.problem).cauchy(u)
     return np.linalg.eigvalsh(sigma.transpose(2, 0, 1))[:, -1]
 
 
+def _nodal_contact_pressure(contact, u: np.ndarray, t: float) -> np.ndarray:
+    """Nodal contact pressure of the IPC barrier at (u, t), or of the penalty contact after its assembly."""
+    return contact.nodal_pressure(u, t) if isinstance(contact, IPCContact) else contact.nodal_pressure(u)
+
+
 class ClosureWriter:
     """Solver callback: ``<stem>_<k>.vtu`` per converged step and ``<stem>.pvd`` (module docstring)."""
 
-    def __init__(self, path, setup: ClosureSetup) -> None:
+    def __init__(self, path, setup: ValveSetup) -> None:
         self.path = Path(path).with_suffix(".pvd")
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self.setup = setup
@@ -225,7 +231,7 @@ class ClosureWriter:
         setup.contact.assemble(u, t, False, None)
         point_data = {"displacement": u[: setup.problem.space.n_u].reshape(-1, 3),
                       "leaflet_id": setup.leaflet_of_vertex.astype(float),
-                      "contact_pressure": setup.contact.nodal_pressure(u)}
+                      "contact_pressure": _nodal_contact_pressure(setup.contact, u, t)}
         cell_data = {"max_principal_cauchy": [max_principal_cauchy(setup, u), np.zeros(n_lines)],
                      "leaflet_id": [setup.model.regions.astype(float), np.full(n_lines, -1.0)]}
         name = f"{self.path.stem}_{len(self.entries):04d}.vtu"
