@@ -207,8 +207,9 @@ def build_parser() -> argparse.ArgumentParser:
     info.add_argument("--out", default="skvalve_out/valve_info", help="folder for summary.txt and undeformed.png")
     info.set_defaults(func=_cmd_valve_info)
     close = valve_sub.add_parser("close", help="close a valve: open configuration to the converged end-systolic state",
-                                 description="Close a Texas TriValve input with the defaults of skvalve.valve.options "
-                                             "(IPC contact, incremental-potential steps, the held load solved to 1e-6).")
+                                 description="Close a Texas TriValve input with the defaults of "
+                                             "skvalve.valve.options (IPC contact, incremental-potential steps, the "
+                                             "held load solved to 1e-6).")
     close.add_argument("file", help="Abaqus input (.inp), e.g. ../shared/data/texas_trivalve/Diseased_QuasiStatic.inp")
     close.add_argument("--out", default="skvalve_out/valve_close",
                        help="folder for state.npz (kept after every step), closure.log and closure.pvd")

@@ -8,8 +8,8 @@ import skfem
 from test_contact import block_contact_problem, closed_form_force, pair_central_differences
 
 from skvalve.fem import Space, solve
-from skvalve.fem.contact import blend as contact_blend
 from skvalve.fem.contact import ContactSurface, SurfaceContact
+from skvalve.fem.contact import blend as contact_blend
 from skvalve.fem.contact.blend import free_edges, normalisation, sheets, weighted_mean_energy
 from skvalve.fem.contact.geometry import barycentric_derivatives, near_pairs, smooth_step
 

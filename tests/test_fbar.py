@@ -127,3 +127,20 @@ def test_pressurised_plate_strip_does_not_lock():
     q1 = _plate_deflection("q1", 40, 4)
     assert fbar == pytest.approx(reference, rel=0.03)
     assert abs(q1) < 0.7 * abs(reference)  # Q1 deflects 40 % too little
+
+
+def test_fbar_term_energy_is_the_potential_of_its_forces():
+    """FBarTerm.energy (used by the incremental solver's line search) against the internal force by central
+    differences, on two laws in two regions; an inverted element makes it +inf."""
+    space = Space(distort(box(2)))
+    regions = np.arange(space.mesh.t.shape[1]) % 2
+    term = FBarTerm(space, [LEAFLET, NeoHookean(1.0, 20.0)], regions=regions)
+    rng = np.random.default_rng(4)
+    u = 0.03 * rng.standard_normal(space.n_dofs)
+    v = rng.standard_normal(space.n_dofs)
+    h = 1e-6
+    fd = (term.energy(u + h * v, 0.0) - term.energy(u - h * v, 0.0)) / (2 * h)
+    assert fd == pytest.approx(term.assemble(u, 0.0, False, 0).internal @ v, rel=1e-6)
+    assert term.energy(np.zeros(space.n_dofs), 0.0) == pytest.approx(0.0, abs=1e-14)
+    folded = -2.5 * space.mesh.p.T.ravel()  # x = -1.5 X: every Jacobian negative
+    assert term.energy(folded, 0.0) == np.inf

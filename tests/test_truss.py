@@ -182,3 +182,40 @@ def test_chord_tied_to_a_block():
     reaction = result.reaction(lambda X: X[0] < 1e-9)
     assert reaction[0] == pytest.approx(-state.axial_force[0], rel=1e-8)
     assert 0 < u[3 * face] < 0.1
+
+
+@pytest.mark.parametrize("law", [CHORD, LinearUniaxial(3.0), TensionOnly(CHORD), TensionOnly(CHORD, 1e-3, 0.05)],
+                         ids=["ogden", "linear", "tension_only", "tension_only_ramp"])
+def test_uniaxial_energy_is_the_integral_of_the_nominal_stress(law):
+    """dW/dlambda = P by central differences (slack and taut stretches, across the ramp), W(1) = 0 for the plain
+    laws; the Ogden bracket's series branch (|alpha ln lambda| < 1e-3) joins the closed form to rounding."""
+    lam = np.array([0.8, 0.97, 0.9995, 1.00002, 1.004, 1.02, 1.049, 1.07])  # not at the tension-only kink 1
+    slack = 0.9
+    extra = (slack,) if isinstance(law, TensionOnly) else ()
+    h = 1e-6
+    fd = (law.energy(lam + h, *extra) - law.energy(lam - h, *extra)) / (2 * h)
+    P = law.nominal_stress(lam, *extra)[0]
+    assert np.allclose(fd, P, rtol=1e-6, atol=1e-9 * np.abs(P).max())
+    if not isinstance(law, TensionOnly):
+        assert law.energy(np.array([1.0]))[0] == 0.0
+    tiny = OgdenUniaxial(mu=(2.0,), alpha=(3.0,))
+    edge = np.exp(np.array([0.999e-3, 1.001e-3]) / 3.0)  # either side of the series' switch
+    closed = 2.0 * 2.0 / 9.0 * (edge**3 + 2.0 * edge**-1.5 - 3.0)
+    assert np.allclose(tiny.energy(edge), closed, rtol=1e-9)
+
+
+def test_truss_energy_gradient_is_its_internal_force():
+    """A chord network of three laws (Ogden, tension-only with a slack stretch, linear) between hex nodes: the
+    directional derivative of Truss.energy by central differences equals the assembled internal force."""
+    space = Space(skfem.MeshHex.init_tensor(*(np.linspace(0.0, 2.0, 3),) * 3))
+    rng = np.random.default_rng(5)
+    pairs = np.array([[0, 26], [1, 13], [4, 22], [8, 18]])
+    laws = [CHORD, TensionOnly(CHORD, 1e-3, 0.05), LinearUniaxial(3.0)]
+    truss = Truss(space, pairs, 0.3, laws, law_index=np.array([0, 1, 1, 2]),
+                  slack_stretch=np.array([1.0, 0.95, 1.0, 1.0]))
+    u = 0.05 * rng.standard_normal(space.n_dofs)
+    v = rng.standard_normal(space.n_dofs)
+    h = 1e-7
+    fd = (truss.energy(u + h * v, 1.0) - truss.energy(u - h * v, 1.0)) / (2 * h)
+    internal = truss.assemble(u, 1.0, False, 0).internal
+    assert fd == pytest.approx(internal @ v, rel=1e-6)

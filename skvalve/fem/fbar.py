@@ -237,6 +237,15 @@ class FBarTerm(Term):
         internal = np.bincount(sp_.element_dofs.ravel(), fe.ravel(), minlength=sp_.n_dofs)
         return Contribution(internal=internal, blocks=[Blocks(sp_.element_dofs, ke if tangent else None)])
 
+    def energy(self, u: np.ndarray, t: float) -> float | None:
+        r""":math:`\Pi = \sum_e\sum_q w_q\,\psi(\bar F_q)` (module docstring), whose gradient is :meth:`assemble`'s
+        internal force; ``inf`` where a Jacobian is not positive, ``None`` when a law has no energy."""
+        F = self.deformation_gradient(u)
+        if not np.all(determinant(F) > 0.0):
+            return float("inf")
+        W = self.materials.energy_density(fbar_deformation(F, self.space.dx)[0])
+        return None if W is None else float(np.sum(W.T * self.space.dx))
+
     def commit(self) -> None:
         for region in self.materials.regions:
             getattr(region.material, "commit", lambda: None)()

@@ -23,7 +23,9 @@ al. 2005), so :math:`p` is a descent direction; once the relative residual is be
 tangent is used (Newton's quadratic rate), falling back to the projected one when its step is not a descent
 direction. The step length starts at the terms' cap (:meth:`~skvalve.fem.problem.Problem.step_fraction`: 0.9 of the
 collision-free share for a barrier, so no iterate intersects) and is halved until the Armijo condition
-:math:`E(u + \alpha p) \le E(u) + c\,\alpha\,\nabla E\cdot p` holds. Where a term has no potential (a follower
+:math:`E(u + \alpha p) \le E(u) + c\,\alpha\,\nabla E\cdot p` holds (near convergence, where the predicted
+decrease :math:`\alpha\,\nabla E\cdot p` falls below ``ENERGY_RESOLUTION`` :math:`|E|`, a step is accepted when the
+gradient's norm falls). Where a term has no potential (a follower
 pressure on an open surface is not conservative) the merit is the residual norm instead (``energy_merit`` False in the
 history): the line search then asks that :math:`|\nabla E|` falls, and every iteration takes the unprojected tangent,
 whose direction is a descent direction of :math:`|\nabla E|` by construction (a projected one need not be: on the
@@ -53,6 +55,10 @@ from .trust_steps import project_psd
 __all__ = ["IncrementalOptions", "StepFailed", "incremental_potential", "minimise_step", "projected_tangent"]
 
 logger = logging.getLogger("skvalve.fem")
+
+#: Relative size below which a predicted change of the total potential is lost in its rounding (a sum over every
+#: quadrature point and barrier stencil): the line search then asks that the gradient's norm falls instead.
+ENERGY_RESOLUTION = 1e-12
 
 
 @dataclass
@@ -243,8 +249,11 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
                 continue
             trial_gradient = trial_residual + inertia * (trial - predictor)
             trial_value = merit(trial, trial_gradient)
-            if energy_merit:
+            if energy_merit and abs(alpha * slope) > ENERGY_RESOLUTION * abs(value):
                 ok = trial_value <= value + opts.armijo * alpha * slope
+            elif energy_merit:  # the decrease is below the energy's rounding: the gradient's norm decides
+                ok = (np.linalg.norm(trial_gradient[free]) < np.linalg.norm(gradient[free])
+                      and trial_value <= value + ENERGY_RESOLUTION * abs(value))
             else:
                 ok = trial_value <= (1.0 - opts.armijo * alpha) * value
             if ok and np.isfinite(trial_value):

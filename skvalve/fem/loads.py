@@ -204,6 +204,13 @@ class FollowerPressure(Term):
         external = -np.bincount(self.element_dofs.ravel(), forces.ravel(), minlength=self.n_dofs)
         return Contribution(external=external, blocks=[Blocks(self.element_dofs, ke)])
 
+    def energy(self, u: np.ndarray, t: float) -> float | None:
+        """0 while the pressure is off at ``t``; otherwise ``None``: a follower pressure on an open surface has no
+        potential (the incremental solver then takes the residual norm as its merit)."""
+        p = float(evaluated_load(self.pressure(t), self.name, self.source, t, shape=(),
+                                 where=f"on {self.n_facets} facet(s)"))
+        return 0.0 if p == 0.0 else None
+
     def element_terms(self, u: np.ndarray, t: float, tangent: bool):
         """Residual contributions (nf, nb*d) and load stiffness (nf, nb*d, nb*d) or None."""
         p = float(evaluated_load(self.pressure(t), self.name, self.source, t, shape=(),

@@ -103,6 +103,26 @@ class LawAssignment:
                 P[mine], dP[mine] = scale * P_k, scale * dP_k
         return P, dP
 
+    def energy(self, stretch: np.ndarray, slack_stretch: np.ndarray | None = None, scale: float = 1.0
+               ) -> np.ndarray | None:
+        """Stored energy per reference volume of every bar (the integral of :meth:`evaluate`'s stress), or ``None``
+        when a law has no ``energy(stretch)``."""
+        W = np.empty_like(stretch)
+        for k, law in enumerate(self.laws):
+            mine = self.index == k
+            if not np.any(mine):
+                continue
+            if getattr(law, "energy", None) is None:
+                return None
+            if isinstance(law, TensionOnly):
+                if getattr(law.law, "energy", None) is None:
+                    return None
+                slack = 1.0 if slack_stretch is None else slack_stretch[mine]
+                W[mine] = law.energy(stretch[mine], slack, scale)
+            else:
+                W[mine] = scale * law.energy(stretch[mine])
+        return W
+
 
 def bar_response(x_a: np.ndarray, x_b: np.ndarray, rest_length: np.ndarray, area: np.ndarray,
                  laws: LawAssignment, tangent: bool = True, slack_stretch: np.ndarray | None = None,
@@ -207,12 +227,17 @@ class Truss(Term):
     def connectivity(self) -> list[np.ndarray]:
         return [self.dofs]
 
-    def response(self, u: np.ndarray, tangent: bool = False, scale: float = 1.0) -> BarResponse:
-        """Stretch, axial force and element forces/tangents of every bar at displacement ``u`` (element vectors
-        and matrices on ``self.dofs``: the nodes of both ends); ``scale`` as ``stiffness_scale``."""
+    def end_positions(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Current positions (n_bars, 3) of both ends of every bar at displacement ``u``."""
         nodal = u[: 3 * self.space.n_scalar].reshape(-1, 3)
         x_a, x_b = (ref + np.einsum("nk,nkd->nd", end.weights, nodal[end.nodes])
                     for ref, end in zip(self.reference, self.ends, strict=True))
+        return x_a, x_b
+
+    def response(self, u: np.ndarray, tangent: bool = False, scale: float = 1.0) -> BarResponse:
+        """Stretch, axial force and element forces/tangents of every bar at displacement ``u`` (element vectors
+        and matrices on ``self.dofs``: the nodes of both ends); ``scale`` as ``stiffness_scale``."""
+        x_a, x_b = self.end_positions(u)
         state = bar_response(x_a, x_b, self.rest_length, self.area, self.laws, tangent, self.slack_stretch, scale)
         if self._spread is None:
             return state
@@ -223,13 +248,26 @@ class Truss(Term):
             state.matrices = np.matmul(np.matmul(spread_t, state.matrices), spread)
         return state
 
+    def _scale(self, t: float, step: int | None) -> float:
+        if self.stiffness_scale is None:
+            return 1.0
+        scale = float(self.stiffness_scale(t))
+        if not (np.isfinite(scale) and scale > 0.0):
+            raise ValueError(f"{self.name}: stiffness_scale must be positive and finite; got {scale!r} at load "
+                             f"factor {t} (load step {step})")
+        return scale
+
+    def energy(self, u: np.ndarray, t: float) -> float | None:
+        r""":math:`\sum_\text{bars} A L\,W(\lambda)` (module docstring); ``None`` when a law has no energy."""
+        x_a, x_b = self.end_positions(u)
+        length = np.linalg.norm(x_b - x_a, axis=1)
+        if not np.all(np.isfinite(length) & (length > 0.0)):
+            return float("inf")
+        W = self.laws.energy(length / self.rest_length, self.slack_stretch, self._scale(t, None))
+        return None if W is None else float(np.sum(self.area * self.rest_length * W))
+
     def assemble(self, u: np.ndarray, t: float, tangent: bool, step: int | None) -> Contribution:
-        scale = 1.0
-        if self.stiffness_scale is not None:
-            scale = float(self.stiffness_scale(t))
-            if not (np.isfinite(scale) and scale > 0.0):
-                raise ValueError(f"{self.name}: stiffness_scale must be positive and finite; got {scale!r} at load "
-                                 f"factor {t} (load step {step})")
+        scale = self._scale(t, step)
         try:
             state = self.response(u, tangent, scale)
         except ValueError as err:

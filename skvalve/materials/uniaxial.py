@@ -73,6 +73,14 @@ def _positive_stretch(stretch: ArrayLike, who: str) -> np.ndarray:
     return stretch
 
 
+def _ogden_bracket(x: np.ndarray) -> np.ndarray:
+    """:math:`e^x + 2e^{-x/2} - 3` without cancellation: its Taylor series
+    :math:`\\tfrac34x^2 + \\tfrac18x^3 + \\tfrac{3}{64}x^4 + \\tfrac{1}{128}x^5` where :math:`|x| < 10^{-3}`."""
+    small = np.abs(x) < 1e-3
+    series = x * x * (0.75 + x * (0.125 + x * (3.0 / 64.0 + x / 128.0)))
+    return np.where(small, series, np.expm1(x) + 2.0 * np.expm1(-0.5 * x))
+
+
 @dataclass(frozen=True)
 class OgdenUniaxial:
     """Incompressible N-term Ogden law (Abaqus convention) in uniaxial stress.
@@ -111,6 +119,14 @@ class OgdenUniaxial:
             dP += c * ((a - 1.0) * lam ** (a - 2.0) + (0.5 * a + 1.0) * lam ** (-0.5 * a - 2.0))
         return P, dP
 
+    def energy(self, stretch: ArrayLike) -> np.ndarray:
+        """Stored energy per reference volume :math:`W(\\lambda)` (module docstring), zero at :math:`\\lambda = 1`."""
+        log = np.log(_positive_stretch(stretch, "OgdenUniaxial"))
+        W = np.zeros_like(log)
+        for m, a in zip(self.mu, self.alpha, strict=True):
+            W += 2.0 * m / a**2 * _ogden_bracket(a * log)
+        return W
+
 
 @dataclass(frozen=True)
 class LinearUniaxial:
@@ -128,6 +144,11 @@ class LinearUniaxial:
     def nominal_stress(self, stretch: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         lam = _positive_stretch(stretch, "LinearUniaxial")
         return self.modulus * (lam - 1.0), np.full_like(lam, float(self.modulus))
+
+    def energy(self, stretch: ArrayLike) -> np.ndarray:
+        """:math:`W = E(\\lambda - 1)^2/2`."""
+        lam = _positive_stretch(stretch, "LinearUniaxial")
+        return 0.5 * self.modulus * (lam - 1.0) ** 2
 
 
 @dataclass(frozen=True)
@@ -178,4 +199,26 @@ class TensionOnly:
         P = k * (lam - lam_s) + scale * w * Pl
         dP = k + scale * (dw * Pl + w * dPl)
         return P, dP
+
+    def energy(self, stretch: ArrayLike, slack_stretch: ArrayLike = 1.0, scale: float = 1.0) -> np.ndarray:
+        r""":math:`W = \tfrac{k_s}{2}(\lambda - \lambda_s)^2 + \int_1^{\max(\lambda, 1)} w\,P_\text{law}\,d\lambda'`
+        (the integral of :meth:`nominal_stress`): on the ramp :math:`1 \le \lambda' \le 1 + \delta` by 12-point
+        Gauss–Legendre quadrature (exact to rounding for the smooth integrand on an interval of length
+        :math:`\delta`), beyond it the law's own energy difference. Needs ``law.energy``."""
+        lam = _positive_stretch(stretch, "TensionOnly")
+        lam_s = np.asarray(slack_stretch, dtype=float)
+        taut = np.maximum(lam, 1.0)
+        W = 0.5 * self.slack_stiffness * (lam - lam_s) ** 2
+        if self.transition == 0.0:
+            return W + scale * self.law.energy(taut)
+        top = 1.0 + self.transition
+        ramp_end = np.minimum(taut, top)
+        nodes, weights = np.polynomial.legendre.leggauss(12)
+        half = 0.5 * (ramp_end - 1.0)
+        points = 1.0 + half[..., None] * (nodes + 1.0)
+        x = (points - 1.0) / self.transition
+        integrand = x * x * (3.0 - 2.0 * x) * self.law.nominal_stress(points)[0]
+        ramp = half * (integrand @ weights)
+        beyond = self.law.energy(np.maximum(taut, top)) - self.law.energy(np.full_like(taut, top))
+        return W + scale * (ramp + beyond)
 

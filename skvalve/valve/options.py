@@ -25,9 +25,11 @@ def _positive(owner: str, name: str, value, zero: bool = False) -> None:
 class ModelOptions:
     """How the input becomes the implicit model (:meth:`~skvalve.valve.model.ValveModel.problem`).
 
-    insertion : ``"patch"`` spreads each chord's pull over the cells around its insertion (a point attachment on a hex
+    insertion
+        ``"patch"`` spreads each chord's pull over the cells around its insertion (a point attachment on a hex
         skin pulls one node through the leaflet), ``"node"`` keeps the input's point attachment.
-    cable_compression : the cables that are one input truss carry their law in compression too, as the input's truss
+    cable_compression
+        the cables that are one input truss carry their law in compression too, as the input's truss
         elements do (a chordae branch point is then held by struts, not by slack springs).
     """
 
@@ -43,14 +45,19 @@ class ModelOptions:
 class ContactOptions:
     """The IPC barrier on the leaflets' whole hex boundary (:class:`~skvalve.fem.contact.IPCContact`).
 
-    dhat : the barrier's range (mm). Below every gap that must stay open at rest: 0.1 mm pairs no primitive of the
+    dhat
+        the barrier's range (mm). Below every gap that must stay open at rest: 0.1 mm pairs no primitive of the
         1.0 diseased valve at rest (0.5 mm pairs 76 266: its 0.39 mm leaflets' two skins).
-    pressure_factor : the stiffness κ carries this many times the input's largest pressure at half of ``dhat``
+    pressure_factor
+        the stiffness κ carries this many times the input's largest pressure at half of ``dhat``
         (:func:`~skvalve.fem.contact.ipc.stiffness_for_pressure`): coapting leaflets then meet about ``dhat``/2 apart.
-    exclude_within : body vertices closer than this (mm) in the reference never collide (the skins across a free edge
+    exclude_within
+        body vertices closer than this (mm) in the reference never collide (the skins across a free edge
         and the commissures, where the leaflets share nodes).
-    friction : ``None`` (frictionless; the 1.0 inputs' friction 0.001 is negligible) or a :class:`Friction`.
-    check_intersections : assert after every accepted step that the collision mesh does not intersect
+    friction
+        ``None`` (frictionless; the 1.0 inputs' friction 0.001 is negligible) or a :class:`Friction`.
+    check_intersections
+        assert after every accepted step that the collision mesh does not intersect
         (``has_intersections``, ~0.03 s on the 1.0 valve): a guard, since the collision-free line search makes it
         impossible by construction.
     """
@@ -76,14 +83,19 @@ class StepOptions:
     that nothing else holds yet (free edges before they meet, slack chordae branch points), and it is dropped at the
     held load.
 
-    damping : :math:`c` (N·s/mm⁴ per unit step time): 1e-4 gives ~0.05 N on a leaflet moving 10 mm per unit step time,
+    damping
+        :math:`c` (N·s/mm⁴ per unit step time): 1e-4 gives ~0.05 N on a leaflet moving 10 mm per unit step time,
         far below the ~1 N the chordae and the pressure carry.
-    first, largest, smallest : the first, largest and smallest step (step time); a failed step is halved, and the run
+    first, largest, smallest
+        the first, largest and smallest step (step time); a failed step is halved, and the run
         stops with the step and step time when it falls below ``smallest``.
-    growth, easy_iterations : a step that converged in at most ``easy_iterations`` iterations lets the next grow by
+    growth, easy_iterations
+        a step that converged in at most ``easy_iterations`` iterations lets the next grow by
         ``growth``.
-    rtol : each path step's tolerance (relative to reactions and loads); the path needs no tighter equilibria.
-    max_iter : iterations per step before it is cut back.
+    rtol
+        each path step's tolerance (relative to reactions and loads); the path needs no tighter equilibria.
+    max_iter
+        iterations per step before it is cut back.
     """
 
     damping: float = 1e-4
@@ -113,10 +125,14 @@ class StepOptions:
 class HoldOptions:
     """The held load at the end: pseudo-steps whose pseudo-mass fades (the step doubles), then the static problem.
 
-    rtol : the undamped, static residual asked for (relative to reactions and loads).
-    static_below : once a held step leaves a static residual below this, the static problem is tried directly.
-    max_steps : held steps before the run stops with its best state.
-    growth : the held pseudo-step's growth per converged step (the pseudo-mass falls by it).
+    rtol
+        the undamped, static residual asked for (relative to reactions and loads).
+    static_below
+        once a held step leaves a static residual below this, the static problem is tried directly.
+    max_steps
+        held steps before the run stops with its best state; 0: no held phase (the path only).
+    growth
+        the held pseudo-step's growth per converged step (the pseudo-mass falls by it).
     """
 
     rtol: float = 1e-6

@@ -14,9 +14,9 @@ same steps at the end time with the pseudo-step doubling (the pseudo-mass fading
 static residual is small, solved to ``rtol`` (1e-6) of the undamped problem. The merit of the line search is the
 residual norm: the follower pressure on the leaflets' open surface and the F-bar hexes have no potential.
 
-Output in ``out``: ``state.npz`` after every accepted step (atomic, :mod:`.state`; ``resume=True`` continues from it
-and repeats the uninterrupted run), ``closure.log`` (one line per step), and at the end ``closure.pvd`` with its
-VTU file. Ctrl-C leaves the last kept state and raises :class:`KeyboardInterrupt`.
+Output in ``out``: ``state.npz`` after every accepted step (atomic, :mod:`skvalve.valve.state`; ``resume=True``
+continues from it and repeats the uninterrupted run), ``closure.log`` (one line per step), and at the end
+``closure.pvd`` with its VTU file. Ctrl-C leaves the last kept state and raises :class:`KeyboardInterrupt`.
 """
 
 from __future__ import annotations
@@ -200,6 +200,8 @@ class _Run:
 
     def hold(self, bar) -> None:
         opts, steps, s = self.options.hold, self.options.steps, self.state
+        if opts.max_steps == 0:  # the path only (e.g. a run that stops part-way along the load path)
+            return
         while s.phase == "hold":
             if s.held_steps >= opts.max_steps:
                 raise ClosureFailed(f"{s.input}: held load not converged in {opts.max_steps} steps (relative "
