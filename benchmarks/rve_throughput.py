@@ -96,7 +96,8 @@ class Solver:
             self.module.solve_many(*head, *middle, *tail, out["relative"])
         else:
             chunks = min(B, CHUNKS_PER_THREAD * numba.get_num_threads())
-            self.module.solve_many(*head, b.first, *middle, *tail, out["relative"], chunks)
+            active, keep = np.arange(B, dtype=np.int64), np.zeros(B, dtype=bool)  # every RVE, tangents computed
+            self.module.solve_many(*head, b.first, *middle, *tail, out["relative"], active, keep, chunks)
         assert np.all(out["status"] == 0), f"{self.name}: not every RVE converged"
         return out
 

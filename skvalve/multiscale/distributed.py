@@ -12,12 +12,14 @@ once and every task touching the chunk is pinned to that worker (``workers=[owne
 ``allow_other_workers=False``), so the batch and the RVE states never travel.
 
 State, as futures. Each chunk has a *committed* state future (positions, F, dx/dF, fiber stretches) living on
-its worker. An evaluation at F submits, per chunk, ``solve(batch, committed, F_chunk)`` → a *trial* future
-on the same worker (the new state plus σ and dσ/dF) and gathers only σ and dσ/dF of every RVE
-(9 + 81 numbers per RVE). :meth:`commit` makes the trial futures the committed ones (nothing moves; the
-worker keeps the trial's arrays); :meth:`rewind` releases them and the workers drop them. Tasks never mutate
-their inputs, so a stress is a function of (committed state, F) exactly as in-process, and the results equal
-the in-process material's bit for bit (each RVE is solved by the same kernel from the same data).
+its worker. An evaluation at F submits, per chunk, ``solve(batch, committed, F_chunk, latest)`` → a *trial*
+future on the same worker (the new state plus σ and dσ/dF) and gathers only σ and dσ/dF of every RVE
+(9 + 81 numbers per RVE). As in-process, each RVE starts from the committed state or from the previous trial
+(``latest``, on the same worker), whichever has the nearer F, and an RVE whose F is unchanged is copied, not
+solved. :meth:`commit` makes the trial futures the committed ones (nothing moves; the worker keeps the trial's
+arrays); :meth:`rewind` releases them and the workers drop them. Tasks never mutate their inputs, so a stress is
+a function of (committed state, previous trial, F) exactly as in-process, and the results equal the in-process
+material's bit for bit (each RVE is solved by the same kernel from the same data).
 No actors are used: a future's data stays on its worker until the client releases it.
 
 Running on a cluster (see ``docs/thomas2019_distributed.md``)::
@@ -80,6 +82,7 @@ class ChunkTrial:
     cauchy: np.ndarray  # (n, 3, 3)
     tangent: np.ndarray  # (n, 3, 3, 3, 3)
     seconds: float = 0.0  # the solve's wall time on the worker
+    results: dict | None = None  # the batch output (RVEBatch.solve): warm start and reuse of unchanged RVEs
 
 
 @dataclass(frozen=True)
@@ -103,8 +106,10 @@ def _build_batch(spec: _ChunkInput) -> tuple[RVEBatch, _ChunkInput]:
     return batch, spec
 
 
-def _solve_chunk(built: tuple[RVEBatch, _ChunkInput], committed: ChunkTrial | None, F: np.ndarray) -> ChunkTrial:
-    """Solve the chunk's RVEs at F from ``committed.state`` (None: cold, the reference solve); inputs not mutated."""
+def _solve_chunk(built: tuple[RVEBatch, _ChunkInput], committed: ChunkTrial | None, F: np.ndarray,
+                 latest: ChunkTrial | None = None) -> ChunkTrial:
+    """Solve the chunk's RVEs at F from ``committed.state`` (None: cold, the reference solve) or, RVE by RVE, from
+    the ``latest`` trial where its F is nearer (as the in-process material does); inputs not mutated."""
     resident, spec = built
     if spec.numba_threads is not None:  # per calling thread in numba: set in the task itself
         numba.set_num_threads(min(spec.numba_threads, numba.config.NUMBA_NUM_THREADS))
@@ -113,11 +118,13 @@ def _solve_chunk(built: tuple[RVEBatch, _ChunkInput], committed: ChunkTrial | No
         state = committed.state
         batch.positions, batch.F_state, batch.sensitivity = state.positions, state.F, state.sensitivity
         batch.has_state = np.ones(len(batch.networks), dtype=bool)
+        batch.accepted = committed.results
     else:
         batch.has_state = np.zeros(len(batch.networks), dtype=bool)
+        batch.accepted = None
     start = time.perf_counter()
     try:
-        out = batch.solve(F, update_state=False)
+        out = batch.solve(F, update_state=False, alternate=None if latest is None else latest.results)
     except RuntimeError as err:
         text = str(err)
         if not text.startswith("RVE "):  # not a force-balance failure (e.g. numba): no cut-back can help
@@ -126,11 +133,11 @@ def _solve_chunk(built: tuple[RVEBatch, _ChunkInput], committed: ChunkTrial | No
         where = f"RVE of element {r // spec.n_points}, quadrature point {r % spec.n_points}"
         raise RVEFailure(f"DistributedRVEMaterial: {where}: {text}") from err
     state = ChunkState(out["x"], np.array(F, copy=True), out["sensitivity"], out["stretch"])
-    return ChunkTrial(state, out["cauchy"], out["tangent"], time.perf_counter() - start)
+    return ChunkTrial(state, out["cauchy"], out["tangent"], time.perf_counter() - start, out)
 
 
-def _stresses(trial: ChunkTrial) -> tuple[np.ndarray, np.ndarray, float]:
-    return trial.cauchy, trial.tangent, trial.seconds
+def _stresses(trial: ChunkTrial) -> tuple[np.ndarray, np.ndarray, float, int]:
+    return trial.cauchy, trial.tangent, trial.seconds, trial.results["solved"]
 
 
 def _state_of(trial: ChunkTrial) -> ChunkState:
@@ -209,7 +216,7 @@ class DistributedRVEMaterial(RVEMaterial):
         self.n_elements, self.n_points = len(networks), int(n_points)
         self.networks = networks
         self.n_rves = self.n_elements * self.n_points
-        self.solves, self.solve_seconds = 0, 0.0
+        self.solves, self.reused, self.evaluations, self.solve_seconds = 0, 0, 0, 0.0
         self.worker_seconds = 0.0  # per evaluation the slowest chunk's solve time on its worker, summed
         self.client = client
         element_bounds = np.linspace(0, self.n_elements, int(n_chunks) + 1).round().astype(int)
@@ -280,14 +287,20 @@ class DistributedRVEMaterial(RVEMaterial):
             r = int(np.flatnonzero(~(det > 0.0))[0]) if np.any(~(det > 0.0)) else 0
             raise RVEFailure(f"DistributedRVEMaterial: det F <= 0 or F not finite at element {r // self.n_points}, "
                              f"point {r % self.n_points}")
-        self._trial = None  # release the previous trial before the new one is computed
+        latest = None if self._trial is None else self._trial[1]
+        self._trial = None  # release the previous trial's stresses before the new one is computed
         start = time.perf_counter()
-        trials = [self._submit(c, _solve_chunk, self._batches[c], self._committed[c], F_rve[s])
+        trials = [self._submit(c, _solve_chunk, self._batches[c], self._committed[c], F_rve[s],
+                               None if latest is None else latest[c])
                   for c, s in enumerate(self._slices())]
+        del latest
         parts = self.client.gather([self._submit(c, _stresses, trial) for c, trial in enumerate(trials)])
         self.solve_seconds += time.perf_counter() - start
         self.worker_seconds += max(p[2] for p in parts)
-        self.solves += self.n_rves
+        solved = sum(p[3] for p in parts)
+        self.solves += solved
+        self.reused += self.n_rves - solved
+        self.evaluations += 1
         out = {"cauchy": np.concatenate([p[0] for p in parts]), "tangent": np.concatenate([p[1] for p in parts])}
         self._trial = (np.array(F, copy=True), trials, out)
         return out

@@ -4,6 +4,7 @@ orientation : SALS orientation tensor H, anisotropy index α, mean direction μ 
 generate    : Delaunay networks clipped to the unit RVE, matched to a target α/μ
 library     : seeded, cached library of networks over an α/μ grid
 rve         : RVE force balance, volume-averaged Cauchy stress (Eq. 8), consistent tangent
+rve_batch   : many RVEs packed for the parallel kernel, warm starts, unchanged RVEs copied
 rve_kernels, rve_tangent, dense_cholesky : the numba kernels (envelope Cholesky in a reverse
 Cuthill–McKee numbering of the interior cross-links)
 plotting    : Fig. 3 / Fig. 6 style plots (imported on demand: needs matplotlib)

@@ -86,27 +86,42 @@ def assemble(x, fibers, rest_length, dof, first, params, residual, matrix, fiber
         force_norm2 += f * f
         stiffness_norm2 += axial * axial
         ia, ib = dof[a], dof[b]
-        for i in range(3):
-            if ia >= 0:
+        if ia >= 0:
+            for i in range(3):
                 residual[3 * ia + i] -= f * e[i]
-            if ib >= 0:
+        if ib >= 0:
+            for i in range(3):
                 residual[3 * ib + i] += f * e[i]
-        if not with_matrix:
+        if not with_matrix or (ia < 0 and ib < 0):
             continue
         lateral = f / length
         if convexified:
             lateral = max(lateral, 0.0)
-        low, high = min(ia, ib), max(ia, ib)  # off-diagonal block goes to row block `high`
-        for i in range(3):
-            for j in range(3):
-                kij = (axial - lateral) * e[i] * e[j] + (lateral if i == j else 0.0)
-                if j <= i:
-                    if ia >= 0:
-                        matrix[3 * ia + i, 3 * ia + j] += kij
-                    if ib >= 0:
-                        matrix[3 * ib + i, 3 * ib + j] += kij
-                if low >= 0:
-                    matrix[3 * high + i, 3 * low + j] -= kij
+        # k_ij = (f'/L0 − f/ℓ) e_i e_j + (f/ℓ) δ_ij, all nine (the off-diagonal block is not symmetric in round-off)
+        s0, s1, s2 = (axial - lateral) * e[0], (axial - lateral) * e[1], (axial - lateral) * e[2]
+        k00, k01, k02 = s0 * e[0] + lateral, s0 * e[1], s0 * e[2]
+        k10, k11, k12 = s1 * e[0], s1 * e[1] + lateral, s1 * e[2]
+        k20, k21, k22 = s2 * e[0], s2 * e[1], s2 * e[2] + lateral
+        for node in (ia, ib):
+            if node >= 0:
+                row = 3 * node
+                matrix[row, row] += k00
+                matrix[row + 1, row] += k10
+                matrix[row + 1, row + 1] += k11
+                matrix[row + 2, row] += k20
+                matrix[row + 2, row + 1] += k21
+                matrix[row + 2, row + 2] += k22
+        if ia >= 0 and ib >= 0:  # off-diagonal block in row block max(ia, ib)
+            high, low = 3 * max(ia, ib), 3 * min(ia, ib)
+            matrix[high, low] -= k00
+            matrix[high, low + 1] -= k01
+            matrix[high, low + 2] -= k02
+            matrix[high + 1, low] -= k10
+            matrix[high + 1, low + 1] -= k11
+            matrix[high + 1, low + 2] -= k12
+            matrix[high + 2, low] -= k20
+            matrix[high + 2, low + 1] -= k21
+            matrix[high + 2, low + 2] -= k22
     return math.sqrt(force_norm2), math.sqrt(stiffness_norm2), min_length
 
 
@@ -135,11 +150,14 @@ def _trial_positions(x, dof, step, alpha, x_trial):
 
 
 @njit(cache=True)
-def solve_network(X, fibers, rest_length, dof, first, n_free, x, params, tol, max_iter, sensitivity, ws):
+def solve_network(X, fibers, rest_length, dof, first, n_free, x, params, tol, max_iter, sensitivity, ws,
+                  keep_start=False):
     """Newton iterations on ``x`` (interior rows updated in place; boundary rows must be F X).
 
     Fills ``sensitivity`` (3 n_free, 9) with dx/dF at the converged state and leaves the
     converged per-fiber data in ``ws``.  Returns (status, iterations, relative residual).
+    ``keep_start``: if the start (the predictor) already satisfies the balance, ``sensitivity`` is
+    left as it is (the start's; see ``solve_one``) and K is not factorised.
     """
     n = 3 * n_free
     residual, trial_residual = ws[0][:n], ws[1][:n]
@@ -149,7 +167,7 @@ def solve_network(X, fibers, rest_length, dof, first, n_free, x, params, tol, ma
     relative = np.inf
     iterations = 0
     previous_norm = 0.0  # forces a factorisation on the first step
-    known = False  # residual and norms at x already known (from the accepted trial step)
+    known = False  # residual, K and norms at x already known (from the accepted trial step)
     for iterations in range(max_iter + 1):
         if not known:
             force_norm, stiffness_norm, min_length = assemble(
@@ -162,8 +180,8 @@ def solve_network(X, fibers, rest_length, dof, first, n_free, x, params, tol, ma
         converged = res_norm <= max(tol * force_norm, ROUNDOFF * stiffness_norm)
         # chord step (reuse the factor) while the residual falls fast, else refactor
         chord = res_norm < CHORD_RATIO * previous_norm
-        if known and (converged or not (chord or iterations == max_iter)):
-            assemble(x, fibers, rest_length, dof, first, params, residual, matrix, fiber_data, True, False)
+        if converged and iterations == 0 and keep_start:
+            return CONVERGED, 0, relative
         if converged:
             positive_definite = factor_with_shift(matrix, work, n, first, True)  # for the tangent
             status = CONVERGED if positive_definite else INDEFINITE
@@ -180,10 +198,11 @@ def solve_network(X, fibers, rest_length, dof, first, n_free, x, params, tol, ma
             step[i] = -residual[i]
         cholesky_solve_vector(work, n, first, step)
         # full step if it lowers the residual (or we are already close); otherwise Armijo
-        # backtracking on the energy Π, for which the step is a descent direction
+        # backtracking on the energy Π, for which the step is a descent direction.  The trial
+        # assembles K as well (the factor lives in ``work``): an accepted step needs it next.
         _trial_positions(x, dof, step, 1.0, x_trial)
         trial_norms = assemble(
-            x_trial, fibers, rest_length, dof, first, params, trial_residual, matrix, fiber_data, False, False
+            x_trial, fibers, rest_length, dof, first, params, trial_residual, matrix, fiber_data, True, False
         )
         trial_res = math.sqrt(np.sum(trial_residual * trial_residual))
         known = trial_res < res_norm or relative < 1e-6
@@ -272,15 +291,25 @@ def solve_one(
     tangent,
     stretch,
     ws,
+    keep_start=False,
 ):
-    """Predict, solve, post-process one RVE; ``sensitivity`` is read then overwritten."""
+    """Predict, solve, post-process one RVE; ``sensitivity`` is read then overwritten.
+
+    ``keep_start`` (the caller has put the start state's dσ/dF in ``tangent`` and checked that F differs
+    from the start's by at most √tol): when the first-order predictor already satisfies the force
+    balance to ``tol``, the start's dx/dF and dσ/dF are kept and only σ is computed at the new
+    positions.  Their change over such a step is O(√tol) relative (1e-5 at tol = 1e-10): it affects the
+    macro Newton tangent, not the stress.
+    """
     predict(X, dof, x_previous, F_previous, sensitivity, F, x)
     status, iterations, relative = solve_network(
-        X, fibers, rest_length, dof, first, n_free, x, params, tol, max_iter, sensitivity, ws
+        X, fibers, rest_length, dof, first, n_free, x, params, tol, max_iter, sensitivity, ws, keep_start
     )
     if status == CONVERGED or status == INDEFINITE:
+        kept = keep_start and iterations == 0
         stress_and_tangent(
-            X, x, fibers, rest_length, dof, F, scale, sensitivity, ws[6], ws[7][:n_free], cauchy, tangent, stretch
+            X, x, fibers, rest_length, dof, F, scale, sensitivity, ws[6], ws[7][:n_free], cauchy, tangent, stretch,
+            not kept,
         )
     return status, iterations, relative
 
@@ -311,20 +340,24 @@ def solve_many(
     status,
     iterations,
     relative,
+    active,
+    keep_start,
     n_chunks,
 ):
-    """``solve_one`` over a batch of RVEs packed end to end (offset arrays of length B + 1).
+    """``solve_one`` for the RVEs listed in ``active`` of a batch packed end to end (offset arrays of length B + 1).
 
-    The batch is cut into ``n_chunks`` contiguous chunks scheduled by ``prange``; each chunk
-    allocates one workspace and reuses it for its RVEs.
+    ``keep_start[r]``: RVE r's start state came with its tangent (already in ``tangent[r]``).
+    The active list is cut into ``n_chunks`` contiguous chunks scheduled by ``prange``; each chunk
+    allocates one workspace and reuses it for its RVEs.  RVEs not listed are not touched.
     """
-    batch = F.shape[0]
+    count = active.shape[0]
     n_max = 3 * np.max(n_free)
     m_max = np.max(fiber_start[1:] - fiber_start[:-1])
     nodes_max = np.max(node_start[1:] - node_start[:-1])
     for chunk in prange(n_chunks):
         ws = workspace(n_max, m_max, nodes_max)
-        for r in range(chunk * batch // n_chunks, (chunk + 1) * batch // n_chunks):
+        for position in range(chunk * count // n_chunks, (chunk + 1) * count // n_chunks):
+            r = active[position]
             n0, n1 = node_start[r], node_start[r + 1]
             m0, m1 = fiber_start[r], fiber_start[r + 1]
             s0, s1 = free_start[r], free_start[r + 1]
@@ -348,4 +381,5 @@ def solve_many(
                 tangent[r],
                 stretch[m0:m1],
                 ws,
+                keep_start[r],
             )

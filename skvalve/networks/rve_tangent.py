@@ -34,9 +34,12 @@ SYM_J = (0, 1, 2, 1, 2, 2)
 
 @njit(cache=True, fastmath=FAST)
 def stress_and_tangent(
-    X, x, fibers, rest_length, dof, F, scale, sensitivity, fiber_data, node_sum, cauchy, tangent, stretch
+    X, x, fibers, rest_length, dof, F, scale, sensitivity, fiber_data, node_sum, cauchy, tangent, stretch,
+    with_tangent=True,
 ):
     """σ = scale/J Σ (f/ℓ) d⊗d (Eq. 8 as a fiber virial) and dσ_ij/dF_pq, fiber stretches.
+
+    ``with_tangent=False`` computes σ and the stretches only (``tangent`` is not written).
 
     The virial's derivative is linear in the end velocities δd = v_b − v_a of each fiber:
     Σ_k A_k δd_k with A_k[ij, c] = ∂(f/ℓ)/∂ℓ (d_c/ℓ) d_i d_j + (f/ℓ)(δ_ic d_j + d_i δ_jc).
@@ -62,6 +65,10 @@ def stress_and_tangent(
             i, j = SYM_I[s], SYM_J[s]
             dd[s] = d[i] * d[j]
             virial[s] += ratio * dd[s]
+        if not with_tangent:
+            continue
+        for s in range(6):
+            i, j = SYM_I[s], SYM_J[s]
             for c in range(3):
                 A[s, c] = scaled * dd[s] * d[c]
             A[s, i] += ratio * d[j]
@@ -86,16 +93,18 @@ def stress_and_tangent(
                     dvirial[s, 3 * p] += A[s, p] * w0
                     dvirial[s, 3 * p + 1] += A[s, p] * w1
                     dvirial[s, 3 * p + 2] += A[s, p] * w2
+    factor = scale / J
+    for s in range(6):
+        i, j = SYM_I[s], SYM_J[s]
+        cauchy[i, j] = cauchy[j, i] = factor * virial[s]
+    if not with_tangent:
+        return
     for node in range(node_sum.shape[0]):
         for s in range(6):
             for c in range(3):
                 g = node_sum[node, s, c]
                 for pq in range(9):
                     dvirial[s, pq] += g * sensitivity[3 * node + c, pq]
-    factor = scale / J
-    for s in range(6):
-        i, j = SYM_I[s], SYM_J[s]
-        cauchy[i, j] = cauchy[j, i] = factor * virial[s]
     for s in range(6):
         i, j = SYM_I[s], SYM_J[s]
         for p in range(3):
