@@ -156,8 +156,10 @@ class RVEMaterial:
         self.reused = 0  # RVE results copied instead of solved (F unchanged since the start state)
         self.evaluations = 0  # batch evaluations (calls that solved or reused every RVE)
         self.solve_seconds = 0.0
+        self.solve_cpu_seconds = 0.0  # CPU time of the process (all threads) during the RVE solves
         self._last: tuple[np.ndarray, dict] | None = None
         self._latest: dict | None = None  # the last evaluation since the commit: an alternative warm start
+        self._spare: dict | None = None  # an evaluation no longer needed: its packed arrays are reused
         # commit the reference state with its sensitivities: the linear predictor for the first step
         out = self.batch.solve_uniform(np.eye(3))
         self._accept(out)
@@ -188,18 +190,26 @@ class RVEMaterial:
             raise RVEFailure(
                 f"RVEMaterial: det F <= 0 or F not finite at element {r // self.n_points}, point {r % self.n_points}"
             )
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.process_time()
         try:
-            out = self.batch.solve(F_rve, update_state=False, alternate=self._latest)
+            buffers, self._spare = self._spare, None
+            out = self.batch.solve(F_rve, update_state=False, alternate=self._latest, buffers=buffers)
         except RuntimeError as err:
             raise RVEFailure(f"RVEMaterial: {self._where(err)}") from err
         self.solve_seconds += time.perf_counter() - start
+        self.solve_cpu_seconds += time.process_time() - cpu
         self.solves += out["solved"]
         self.reused += self.n_rves - out["solved"]
         self.evaluations += 1
         self._last = (np.array(F, copy=True), out)
+        self._recycle(self._latest)
         self._latest = out
         return out
+
+    def _recycle(self, out: dict | None) -> None:
+        """Keep the packed arrays of an evaluation that is neither committed nor the latest for the next one."""
+        if out is not None and out is not self.batch.accepted and out is not self._latest:
+            self._spare = out
 
     def _where(self, err: Exception) -> str:
         """Error text with the RVE index translated to element and quadrature point."""
@@ -242,10 +252,12 @@ class RVEMaterial:
 
     # ------------------------------------------------------------------ state
     def _accept(self, out: dict) -> None:
+        previous = self.batch.accepted
         self.batch.accept(out)
         self._stretch = out["stretch"]
         self._last = None
         self._latest = None
+        self._recycle(previous)
 
     def commit(self) -> None:
         """Accept the RVE states of the last evaluation (call after a converged load step)."""
@@ -254,8 +266,8 @@ class RVEMaterial:
 
     def rewind(self) -> None:
         """Forget every evaluation since the last commit (the committed arrays are not touched)."""
-        self._last = None
-        self._latest = None
+        latest, self._latest, self._last = self._latest, None, None
+        self._recycle(latest)
 
     def state(self) -> RVEMaterialState:
         """Copy of the committed state (for checkpoints)."""

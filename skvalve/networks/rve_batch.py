@@ -182,7 +182,8 @@ class RVEBatch:
         s0, s1 = self.free_start[index], self.free_start[index + 1]
         return RVEState(self.positions[n0:n1].copy(), self.F_state[index].copy(), self.sensitivity[s0:s1].copy())
 
-    def solve(self, F: np.ndarray, update_state: bool = True, alternate: dict | None = None) -> dict:
+    def solve(self, F: np.ndarray, update_state: bool = True, alternate: dict | None = None,
+              buffers: dict | None = None) -> dict:
         """Solve every RVE at its F; returns arrays cauchy (B,3,3), tangent (B,3,3,3,3), x, F, ...
 
         Each RVE starts from its stored state with the first-order predictor, or — when ``alternate``
@@ -194,56 +195,67 @@ class RVEBatch:
         Where the start has results, F differs from the start's by at most √tol in every entry and the
         first-order predictor already satisfies the balance, the start's dσ/dF and dx/dF are kept
         (:func:`~skvalve.networks.rve_kernels.solve_one`: they differ from the new state's by O(√tol)
-        relative) and only σ is computed.
+        relative) and only σ is computed.  ``buffers``: an earlier output no longer needed, whose packed
+        arrays (x, sensitivity, stretch) are overwritten instead of allocating new ones.
         """
         F = _check_F(F, "RVEBatch.solve")
         batch = len(self.networks)
         if F.shape != (batch, 3, 3):
             raise ValueError(f"RVEBatch.solve: F must have shape ({batch}, 3, 3), got {F.shape}")
-        x_previous, F_previous = self.positions.copy(), self.F_state.copy()
-        sensitivity = self.sensitivity.copy()
-        source = {"x": x_previous, "F": F_previous, "sensitivity": sensitivity}
-        known = np.zeros(batch, dtype=bool) if self.accepted is None else self.has_state.copy()
         use_alternate = np.zeros(batch, dtype=bool)
+        F_start = self.F_state.copy()
         if alternate is not None:
             distance = np.abs(F - self.F_state).max(axis=(1, 2))
             use_alternate = ~self.has_state | (np.abs(F - alternate["F"]).max(axis=(1, 2)) < distance)
-            self._copy_rves(source, alternate, use_alternate, ("x", "F", "sensitivity"))
-            known |= use_alternate
-        for r in np.flatnonzero(~self.has_state & ~use_alternate):  # cold start: affine guess
-            n0, n1 = self.node_start[r], self.node_start[r + 1]
-            x_previous[n0:n1] = self.X[n0:n1] @ F[r].T
-            F_previous[r] = F[r]
-            sensitivity[self.free_start[r] : self.free_start[r + 1]] = 0.0
-        out = dict(
-            x=np.empty_like(self.X),
-            F=np.array(F, copy=True),
-            cauchy=np.zeros((batch, 3, 3)),
-            tangent=np.zeros((batch, 3, 3, 3, 3)),
-            stretch=np.empty(len(self.fibers)),
-            status=np.zeros(batch, dtype=np.int64),
-            iterations=np.zeros(batch, dtype=np.int64),
-            residual=np.zeros(batch),
-            sensitivity=sensitivity,
-        )
-        reuse = known & np.all(F == F_previous, axis=(1, 2))
-        for results, chosen in ((self.accepted, known & ~use_alternate), (alternate, known & use_alternate)):
-            if chosen.any():  # the start's tangent (kept if its predictor needs no iteration), all of a copy
-                self._copy_rves(out, results, chosen & ~reuse, ("tangent",))
-                self._copy_rves(out, results, chosen & reuse,
-                                ("x", "cauchy", "tangent", "stretch", "status", "residual"))
+            F_start[use_alternate] = alternate["F"][use_alternate]
+        cold = ~self.has_state & ~use_alternate
+        F_start[cold] = np.eye(3)  # a failed cold start is retried from the reference state
+        start = np.where(use_alternate, kernels.START_ALTERNATE, kernels.START_STATE)
+        start[cold] = kernels.START_COLD
+        known = use_alternate | (self.has_state & ~use_alternate & (self.accepted is not None))
+        reuse = known & np.all(F == F_start, axis=(1, 2))
+        # the start's tangent may be kept only for a step within √tol (a network whose predictor is exact,
+        # e.g. one without interior cross-links, converges at once after any step)
+        keep = known & ~reuse & (np.abs(F - F_start).max(axis=(1, 2)) <= math.sqrt(self.tol))
+        out = self._outputs(F, buffers)
+        for results, chosen in ((self.accepted, ~use_alternate), (alternate, use_alternate)):
+            if results is not None:
+                copied, kept = reuse & chosen, keep & chosen
+                for name in ("cauchy", "tangent", "status", "residual"):
+                    out[name][copied] = results[name][copied]
+                out["tangent"][kept] = results["tangent"][kept]
+        if reuse.any():
+            source = alternate if alternate is not None else self.accepted
+            stored = self.accepted if self.accepted is not None else source
+            kernels.copy_rows(self.node_start, self.fiber_start, self.free_start, np.flatnonzero(reuse),
+                              use_alternate, self.positions, source["x"], self.sensitivity, source["sensitivity"],
+                              stored["stretch"], source["stretch"], out["x"], out["sensitivity"], out["stretch"])
         active = np.flatnonzero(~reuse)
         if active.size:
-            # the start's tangent may be kept only for a step within √tol (a network whose predictor is exact,
-            # e.g. one without interior cross-links, converges at once after any step)
-            near = np.abs(F - F_previous).max(axis=(1, 2)) <= math.sqrt(self.tol)
-            self._solve_active(active, F, x_previous, F_previous, sensitivity, out, known & near)
+            self._solve_active(active, F, start, alternate, out, keep)
         for r in active[out["status"][active] != kernels.CONVERGED]:
-            self._substep(r, F[r], x_previous, F_previous, sensitivity, out)
+            self._substep(r, F[r], self._start_positions(r, start[r], alternate), F_start[r], out)
         out["solved"] = int(active.size)
         if update_state:
             self.accept(out)
         return out
+
+    def _outputs(self, F: np.ndarray, buffers: dict | None) -> dict:
+        batch = len(self.networks)
+        if buffers is None:
+            buffers = dict(x=np.empty_like(self.X), sensitivity=np.empty_like(self.sensitivity),
+                           stretch=np.empty(len(self.fibers)))
+        return dict(
+            x=buffers["x"],
+            sensitivity=buffers["sensitivity"],
+            stretch=buffers["stretch"],
+            F=np.array(F, copy=True),
+            cauchy=np.zeros((batch, 3, 3)),
+            tangent=np.zeros((batch, 3, 3, 3, 3)),
+            status=np.zeros(batch, dtype=np.int64),
+            iterations=np.zeros(batch, dtype=np.int64),
+            residual=np.zeros(batch),
+        )
 
     def accept(self, out: dict) -> None:
         """Make the output of :meth:`solve` the stored state (its results are kept for reuse)."""
@@ -253,25 +265,31 @@ class RVEBatch:
         self.has_state[:] = True
         self.accepted = out
 
-    def _copy_rves(self, target: dict, source: dict, chosen: np.ndarray, names: Sequence[str]) -> None:
-        """Copy the rows of the chosen RVEs from ``source`` into ``target`` for each packed array in ``names``."""
-        rows = {"x": self._node_rve, "sensitivity": self._free_rve, "stretch": self._fiber_rve}
-        for name in names:
-            mask = chosen[rows[name]] if name in rows else chosen
-            target[name][mask] = source[name][mask]
+    def _start_positions(self, r: int, start: int, alternate: dict | None) -> np.ndarray:
+        """Node positions RVE ``r`` starts from (its stored state, the alternate one, or the reference X)."""
+        n0, n1 = self.node_start[r], self.node_start[r + 1]
+        if start == kernels.START_COLD:
+            return self.X[n0:n1].copy()
+        return (alternate["x"] if start == kernels.START_ALTERNATE else self.positions)[n0:n1].copy()
 
-    def _solve_active(self, active, F, x_previous, F_previous, sensitivity, out, keep_start) -> None:
+    def _solve_active(self, active, F, start, alternate, out, keep_start) -> None:
+        source = self if alternate is None else None
+        x_alternate = self.positions if source is not None else alternate["x"]
+        F_alternate = self.F_state if source is not None else alternate["F"]
+        sensitivity_alternate = self.sensitivity if source is not None else alternate["sensitivity"]
         if active.size == 1:  # serial kernel: no parallel compilation for single solves
             r = int(active[0])
             n0, n1 = self.node_start[r], self.node_start[r + 1]
             m0, m1 = self.fiber_start[r], self.fiber_start[r + 1]
             s0, s1 = self.free_start[r], self.free_start[r + 1]
+            from_alternate = start[r] == kernels.START_ALTERNATE
             workspace = kernels.workspace(3 * self.n_free[r], m1 - m0, n1 - n0)
             out["status"][r], out["iterations"][r], out["residual"][r] = kernels.solve_one(
                 *self._network_arrays(r),
-                x_previous[n0:n1],
-                F_previous[r],
-                sensitivity[s0:s1],
+                (x_alternate if from_alternate else self.positions)[n0:n1],
+                (F_alternate if from_alternate else self.F_state)[r],
+                (sensitivity_alternate if from_alternate else self.sensitivity)[s0:s1],
+                bool(start[r] == kernels.START_COLD),
                 F[r],
                 self.params,
                 self.scale[r],
@@ -281,6 +299,7 @@ class RVEBatch:
                 out["cauchy"][r],
                 out["tangent"][r],
                 out["stretch"][m0:m1],
+                out["sensitivity"][s0:s1],
                 workspace,
                 bool(keep_start[r]),
             )
@@ -295,15 +314,20 @@ class RVEBatch:
             self.dof,
             self.first,
             self.n_free,
-            x_previous,
-            F_previous,
-            sensitivity,
+            self.positions,
+            self.F_state,
+            self.sensitivity,
+            x_alternate,
+            F_alternate,
+            sensitivity_alternate,
+            start.astype(np.int64),
             F,
             self.params,
             self.scale,
             self.tol,
             self.max_iter,
             out["x"],
+            out["sensitivity"],
             out["cauchy"],
             out["tangent"],
             out["stretch"],
@@ -344,8 +368,8 @@ class RVEBatch:
             self.n_free[r],
         )
 
-    def _substep(self, r, F_target, x_previous, F_previous, sensitivity, out) -> None:
-        """Retry a failed RVE from its start state in 2, 4, ..., 64 increments."""
+    def _substep(self, r, F_target, x_first, F_first, out) -> None:
+        """Retry a failed RVE from its start (positions ``x_first`` at ``F_first``) in 2, 4, ..., 64 increments."""
         if out["status"][r] == kernels.INDEFINITE:
             warnings.warn(
                 f"RVE {r}: equilibrium on an indefinite stiffness (unstable); tangent approximate",
@@ -359,9 +383,8 @@ class RVEBatch:
         args = self._network_arrays(r)
         workspace = kernels.workspace(s1 - s0, m1 - m0, n1 - n0)
         for n_steps in (2, 4, 8, 16, 32, 64):
-            x_start = x_previous[n0:n1].copy()
-            F_start = F_previous[r].copy()
-            sens = np.zeros((s1 - s0, 9))
+            x_start, F_start = x_first.copy(), F_first.copy()
+            sens_start, sens = np.zeros((s1 - s0, 9)), np.zeros((s1 - s0, 9))
             x = np.empty_like(x_start)
             for step in range(1, n_steps + 1):
                 F_step = F_start + (F_target - F_start) * step / n_steps
@@ -369,7 +392,8 @@ class RVEBatch:
                     *args,
                     x_start,
                     F_start,
-                    sens,
+                    sens_start,
+                    False,
                     F_step,
                     self.params,
                     self.scale[r],
@@ -379,15 +403,17 @@ class RVEBatch:
                     out["cauchy"][r],
                     out["tangent"][r],
                     out["stretch"][m0:m1],
+                    sens,
                     workspace,
+                    False,
                 )
                 if status not in (kernels.CONVERGED, kernels.INDEFINITE):
                     break
-                x_start, F_start = x.copy(), F_step
+                x_start, F_start, sens_start, sens = x.copy(), F_step, sens, sens_start
             if status in (kernels.CONVERGED, kernels.INDEFINITE):
                 out["x"][n0:n1] = x
                 out["status"][r], out["iterations"][r], out["residual"][r] = status, iterations, residual
-                sensitivity[s0:s1] = sens
+                out["sensitivity"][s0:s1] = sens_start
                 return
         raise RuntimeError(
             f"RVE {r}: force balance did not converge even in 64 increments "

@@ -28,6 +28,8 @@ from skvalve.networks.rve_tangent import FIBER_DATA_COLUMNS, stress_and_tangent
 
 # status codes of ``solve_network``
 CONVERGED, NOT_CONVERGED, INDEFINITE, COLLAPSED = 0, 1, 2, 3
+# where an RVE of ``solve_many`` starts from: its stored state, the alternate one, the affine guess
+START_STATE, START_ALTERNATE, START_COLD = 0, 1, 2
 # Convergence: ‖r‖ ≤ tol ‖f‖ (forces in units of E_f A_f), or ‖r‖ below the round-off level
 # ROUNDOFF · ‖(f'/L0)_k‖ — the residual that position errors of ~10 machine epsilons cause
 # (it matters for nearly unloaded networks, where ‖f‖ itself is round-off, and for very short
@@ -255,12 +257,15 @@ def _sensitivities(X, x, fibers, dof, first, n_free, factor, fiber_data, sensiti
 
 
 @njit(cache=True)
-def predict(X, dof, x_previous, F_previous, sensitivity, F, x):
-    """Boundary x = F X; interior x = x_prev + (dx/dF) : (F − F_prev) (first-order predictor)."""
+def predict(X, dof, x_previous, F_previous, sensitivity, F, x, cold=False):
+    """Boundary x = F X; interior x = x_prev + (dx/dF) : (F − F_prev) (first-order predictor).
+
+    ``cold``: no start state, every node at x = F X (the affine guess; ``x_previous`` etc. not read).
+    """
     for node in range(X.shape[0]):
         i = dof[node]
         for c in range(3):
-            if i < 0:
+            if i < 0 or cold:
                 x[node, c] = F[c, 0] * X[node, 0] + F[c, 1] * X[node, 1] + F[c, 2] * X[node, 2]
             else:
                 value = x_previous[node, c]
@@ -280,7 +285,8 @@ def solve_one(
     n_free,
     x_previous,
     F_previous,
-    sensitivity,
+    sensitivity_previous,
+    cold,
     F,
     params,
     scale,
@@ -290,10 +296,12 @@ def solve_one(
     cauchy,
     tangent,
     stretch,
+    sensitivity,
     ws,
     keep_start=False,
 ):
-    """Predict, solve, post-process one RVE; ``sensitivity`` is read then overwritten.
+    """Predict from the start (``x_previous``, ``F_previous``, ``sensitivity_previous``; or ``cold``), solve,
+    post-process one RVE into ``x``, ``cauchy``, ``tangent``, ``stretch`` and ``sensitivity`` (dx/dF).
 
     ``keep_start`` (the caller has put the start state's dσ/dF in ``tangent`` and checked that F differs
     from the start's by at most √tol): when the first-order predictor already satisfies the force
@@ -301,12 +309,14 @@ def solve_one(
     positions.  Their change over such a step is O(√tol) relative (1e-5 at tol = 1e-10): it affects the
     macro Newton tangent, not the stress.
     """
-    predict(X, dof, x_previous, F_previous, sensitivity, F, x)
+    predict(X, dof, x_previous, F_previous, sensitivity_previous, F, x, cold)
     status, iterations, relative = solve_network(
-        X, fibers, rest_length, dof, first, n_free, x, params, tol, max_iter, sensitivity, ws, keep_start
+        X, fibers, rest_length, dof, first, n_free, x, params, tol, max_iter, sensitivity, ws, keep_start and not cold
     )
     if status == CONVERGED or status == INDEFINITE:
-        kept = keep_start and iterations == 0
+        kept = keep_start and not cold and iterations == 0
+        if kept:
+            sensitivity[:, :] = sensitivity_previous
         stress_and_tangent(
             X, x, fibers, rest_length, dof, F, scale, sensitivity, ws[6], ws[7][:n_free], cauchy, tangent, stretch,
             not kept,
@@ -325,15 +335,20 @@ def solve_many(
     dof,
     first,
     n_free,
-    x_previous,
-    F_previous,
-    sensitivity,
+    x_state,
+    F_state,
+    sensitivity_state,
+    x_alternate,
+    F_alternate,
+    sensitivity_alternate,
+    start,
     F,
     params,
     scale,
     tol,
     max_iter,
     x,
+    sensitivity,
     cauchy,
     tangent,
     stretch,
@@ -346,6 +361,8 @@ def solve_many(
 ):
     """``solve_one`` for the RVEs listed in ``active`` of a batch packed end to end (offset arrays of length B + 1).
 
+    RVE r starts from the stored state (``start[r]`` = ``START_STATE``), the alternate one (``START_ALTERNATE``)
+    or the affine guess (``START_COLD``); results go to ``x``, ``sensitivity``, ... (never to a start array).
     ``keep_start[r]``: RVE r's start state came with its tangent (already in ``tangent[r]``).
     The active list is cut into ``n_chunks`` contiguous chunks scheduled by ``prange``; each chunk
     allocates one workspace and reuses it for its RVEs.  RVEs not listed are not touched.
@@ -361,6 +378,10 @@ def solve_many(
             n0, n1 = node_start[r], node_start[r + 1]
             m0, m1 = fiber_start[r], fiber_start[r + 1]
             s0, s1 = free_start[r], free_start[r + 1]
+            alternate = start[r] == START_ALTERNATE
+            x_previous = x_alternate[n0:n1] if alternate else x_state[n0:n1]
+            F_previous = F_alternate[r] if alternate else F_state[r]
+            sensitivity_previous = sensitivity_alternate[s0:s1] if alternate else sensitivity_state[s0:s1]
             status[r], iterations[r], relative[r] = solve_one(
                 X[n0:n1],
                 fibers[m0:m1],
@@ -368,9 +389,10 @@ def solve_many(
                 dof[n0:n1],
                 first[s0:s1],
                 n_free[r],
-                x_previous[n0:n1],
-                F_previous[r],
-                sensitivity[s0:s1],
+                x_previous,
+                F_previous,
+                sensitivity_previous,
+                start[r] == START_COLD,
                 F[r],
                 params,
                 scale[r],
@@ -380,6 +402,27 @@ def solve_many(
                 cauchy[r],
                 tangent[r],
                 stretch[m0:m1],
+                sensitivity[s0:s1],
                 ws,
                 keep_start[r],
             )
+
+
+@njit(cache=True, parallel=True)
+def copy_rows(node_start, fiber_start, free_start, rves, from_alternate, x_state, x_alternate, sensitivity_state,
+              sensitivity_alternate, stretch_state, stretch_alternate, x, sensitivity, stretch):
+    """Copy the packed rows (positions, dx/dF, fiber stretches) of the listed RVEs from the stored or the alternate
+    results (``from_alternate[r]``) into the output arrays (RVEs whose F did not change)."""
+    for position in prange(rves.shape[0]):
+        r = rves[position]
+        n0, n1 = node_start[r], node_start[r + 1]
+        m0, m1 = fiber_start[r], fiber_start[r + 1]
+        s0, s1 = free_start[r], free_start[r + 1]
+        if from_alternate[r]:
+            x[n0:n1] = x_alternate[n0:n1]
+            sensitivity[s0:s1] = sensitivity_alternate[s0:s1]
+            stretch[m0:m1] = stretch_alternate[m0:m1]
+        else:
+            x[n0:n1] = x_state[n0:n1]
+            sensitivity[s0:s1] = sensitivity_state[s0:s1]
+            stretch[m0:m1] = stretch_state[m0:m1]
