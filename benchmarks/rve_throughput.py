@@ -94,10 +94,15 @@ class Solver:
         tail = (out["x"], out["cauchy"], out["tangent"], out["stretch"], out["status"], out["iterations"])
         if self.reference:
             self.module.solve_many(*head, *middle, *tail, out["relative"])
-        else:
+        else:  # every RVE from the given start (stored = alternate), tangents computed, into new arrays
             chunks = min(B, CHUNKS_PER_THREAD * numba.get_num_threads())
-            active, keep = np.arange(B, dtype=np.int64), np.zeros(B, dtype=bool)  # every RVE, tangents computed
-            self.module.solve_many(*head, b.first, *middle, *tail, out["relative"], active, keep, chunks)
+            active, keep, start = np.arange(B, dtype=np.int64), np.zeros(B, dtype=bool), np.zeros(B, dtype=np.int64)
+            sensitivity = np.empty_like(sensitivity0)
+            self.module.solve_many(*head, b.first, b.n_free, x_previous, F_previous, sensitivity0, x_previous,
+                                   F_previous, sensitivity0, start, F, b.params, b.scale, b.tol, b.max_iter,
+                                   out["x"], sensitivity, out["cauchy"], out["tangent"], out["stretch"],
+                                   out["status"], out["iterations"], out["relative"], active, keep, chunks)
+            out["sensitivity"] = sensitivity
         assert np.all(out["status"] == 0), f"{self.name}: not every RVE converged"
         return out
 
