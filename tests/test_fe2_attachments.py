@@ -10,13 +10,17 @@ not lock and the Gauss-point stresses are not polluted by a pressure checkerboar
   it doubles when the mesh size halves (uniform edges: no change).
 """
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 from scipy.optimize import brentq
 
 from skvalve.fem import solve
+from skvalve.kinematics import green_lagrange
 from skvalve.materials import NeoHookean
 from skvalve.papers.thomas2019 import data
+from skvalve.papers.thomas2019.analysis import local_stretches, table1_extremes, tine_distance, tine_influence_radius
 from skvalve.papers.thomas2019.attachments import DEFAULT_TINES, UNIFORM_EDGES, Tines, _snap, tine_fractions
 from skvalve.papers.thomas2019.models import fe2_material
 from skvalve.papers.thomas2019.protocols import biaxial_problem, edge_tensions, run_protocol
@@ -139,3 +143,38 @@ def test_fe2_protocol_with_tines_reaches_the_tensions(tmp_path):
                            attachment=attachment, max_corrections=10)
         assert np.abs(run.path_tension[-1] - [10.0, 5.0]).max() <= 0.05
         assert run.grips.attachment is attachment and run.grips.nodes["right"].size == 2 * 2  # 2 tines x 2 layers
+
+
+def _run(divisions, attachment, delta=DELTA):
+    """A run-like record of the neo-Hookean solve, for the post-processing of analysis.py."""
+    sample, solid, grips, u, _ = _solve(divisions, attachment, delta)
+    return sample, SimpleNamespace(solid=solid, material=LAW, u=u, grips=grips)
+
+
+def test_tine_points_distances_and_influence_radius():
+    sample, run = _run((16, 16, 1), DEFAULT_TINES)
+    width, height, _ = sample.size
+    points = run.grips.points(width, height)
+    along = np.array([0.125, 0.375, 0.625, 0.875]) * 7e-3  # 16 divisions: the tines sit exactly on node columns
+    expected = np.concatenate([np.stack([np.zeros(4), along]), np.stack([np.full(4, 7e-3), along]),
+                               np.stack([along, np.zeros(4)]), np.stack([along, np.full(4, 7e-3)])], axis=1)
+    np.testing.assert_allclose(points, expected, atol=1e-15)
+    assert tine_influence_radius(run) == pytest.approx(2 * 1.75e-3 / np.pi, rel=1e-12)  # 2 s / pi, s = 7 mm / 4
+    distance = tine_distance(run)
+    centres = sample.mesh.p[:2, sample.mesh.t].mean(axis=1)
+    corner = int(np.argmin(np.linalg.norm(centres, axis=0)))  # element centre (0.219, 0.219) mm, tines at 0.875 mm
+    assert distance[corner] == pytest.approx(np.hypot(0.21875e-3, 0.875e-3 - 0.21875e-3), rel=1e-12)
+    _, uniform = _run((4, 4, 1), UNIFORM_EDGES)
+    assert uniform.grips.points(width, height).shape == (2, 0) and np.all(np.isinf(tine_distance(uniform)))
+
+
+def test_local_stretches_and_extremes_of_chosen_elements():
+    """Uniform edges give the homogeneous state: every element's stretches are the grips' 1 + delta / L."""
+    sample, run = _run((4, 4, 1), UNIFORM_EDGES)
+    for element in (0, 7, 15):
+        np.testing.assert_allclose(local_stretches(run, element), 1 + DELTA / 7e-3, rtol=1e-9)
+    every = table1_extremes(run)
+    assert table1_extremes(run, np.ones(sample.n_elements, dtype=bool)) == every
+    one = table1_extremes(run, np.array([5]))
+    E = green_lagrange(run.solid.deformation_gradient(run.u))[:, :, :, 5]
+    assert one["E11"] == (E[0, 0].min(), E[0, 0].max())

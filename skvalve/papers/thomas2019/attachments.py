@@ -120,6 +120,15 @@ class Grips:
     pinned: bool
     positions: dict[str, np.ndarray]
 
+    def points(self, width: float, height: float) -> np.ndarray:
+        """(2, n) reference in-plane positions (m) of all tines, every edge; (2, 0) for uniform edges."""
+        xy = []
+        for name, axis, sign in EDGES:
+            along = self.positions[name]
+            across = np.full(along.size, 0.0 if sign < 0 else (width, height)[axis])
+            xy.append(np.stack([across, along]) if axis == 0 else np.stack([along, across]))
+        return np.concatenate(xy, axis=1)
+
     def tensions(self, solid: Solid, residual: np.ndarray, width: float, height: float) -> np.ndarray:
         """(T1, T2) in N/m: summed x reactions of the right grips / H, y reactions of the top grips / W."""
         space = solid.space
