@@ -77,3 +77,29 @@ def test_material_counts_solved_and_copied_rves_and_rewind_restarts_from_the_com
     P_again, A_again = material.pk1_and_tangent(G)
     assert np.array_equal(P_again, P_first) and np.array_equal(A_again, A_first)
 
+
+
+def test_recycled_arrays_give_the_same_numbers_as_fresh_ones(networks, fiber, matrix):
+    """The material reuses the packed arrays of an evaluation it no longer needs (neither committed nor the latest);
+    the sequence evaluate, evaluate, commit, evaluate, rewind, evaluate gives bit for bit what fresh arrays give."""
+    def sequence(material):
+        base = np.broadcast_to(np.diag([1.06, 1.04, 0.92])[:, :, None, None], (3, 3, 2, 2)).copy()
+        results, arrays = [], []
+        for k, action in enumerate(("eval", "eval", "eval", "commit", "eval", "eval", "rewind", "eval")):
+            if action == "commit":
+                material.commit()
+            elif action == "rewind":
+                material.rewind()
+            else:
+                results.append(material.pk1_and_tangent(base + 0.004 * k * np.eye(3)[:, :, None, None]))
+                arrays.append(material._latest["x"])
+        return results, arrays
+
+    recycled = RVEMaterial(networks[:2], matrix, fiber, n_points=2, psi=PSI, fiber_diameter=DIAMETER, tol=TOL)
+    fresh = RVEMaterial(networks[:2], matrix, fiber, n_points=2, psi=PSI, fiber_diameter=DIAMETER, tol=TOL)
+    fresh._recycle = lambda out: None  # never reuse: every evaluation allocates
+    (got, arrays), (expected, fresh_arrays) = sequence(recycled), sequence(fresh)
+    for (P, A), (P0, A0) in zip(got, expected, strict=True):
+        assert np.array_equal(P, P0) and np.array_equal(A, A0)
+    assert arrays[2] is arrays[0]  # the third evaluation wrote into the first one's arrays
+    assert len({id(x) for x in fresh_arrays}) == len(fresh_arrays)

@@ -202,8 +202,8 @@ class RVEMaterial:
         self.reused += self.n_rves - out["solved"]
         self.evaluations += 1
         self._last = (np.array(F, copy=True), out)
-        self._recycle(self._latest)
-        self._latest = out
+        previous, self._latest = self._latest, out
+        self._recycle(previous)
         return out
 
     def _recycle(self, out: dict | None) -> None:
