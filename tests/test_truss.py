@@ -7,6 +7,7 @@ import skfem
 
 from skvalve.fem import NodalForce, Problem, Solid, Space, solve
 from skvalve.fem.truss import LawAssignment, Truss, bar_response
+from skvalve.fem.trust_steps import project_psd
 from skvalve.materials import NeoHookean, Ogden
 from skvalve.materials.uniaxial import LinearUniaxial, OgdenUniaxial, TensionOnly
 
@@ -219,3 +220,26 @@ def test_truss_energy_gradient_is_its_internal_force():
     fd = (truss.energy(u + h * v, 1.0) - truss.energy(u - h * v, 1.0)) / (2 * h)
     internal = truss.assemble(u, 1.0, False, 0).internal
     assert fd == pytest.approx(internal @ v, rel=1e-6)
+
+
+class _Softening:
+    """A falling branch: P = -0.5 (lambda - 1) (negative axial stiffness)."""
+
+    def nominal_stress(self, stretch):
+        return -0.5 * (stretch - 1.0), np.full_like(stretch, -0.5)
+
+
+def test_closed_form_projection_is_the_nearest_psd_bar_tangent():
+    """Bars in compression (negative geometric stiffness) and on a falling law branch (negative axial stiffness):
+    the closed-form projection equals the eigendecomposition's nearest PSD matrix; taut bars keep their tangent."""
+    rng = np.random.default_rng(8)
+    n = 8
+    x_a, x_b = rng.standard_normal((n, 3)), rng.standard_normal((n, 3))
+    length = np.linalg.norm(x_b - x_a, axis=1)
+    rest = length * np.where(np.arange(n) % 2, 1.2, 0.9)  # odd bars compressed, even ones stretched
+    laws = LawAssignment([LinearUniaxial(3.0), _Softening()], np.arange(n) % 4 // 2, n)
+    state = bar_response(x_a, x_b, rest, rng.uniform(0.2, 0.5, n), laws)
+    assert np.any(state.axial_force < 0.0)
+    assert np.allclose(state.projected, project_psd(state.matrices), atol=1e-12 * np.abs(state.matrices).max())
+    taut = (state.axial_force > 0.0) & (np.arange(n) % 4 // 2 == 0)
+    assert np.array_equal(state.projected[taut], state.matrices[taut])

@@ -1,4 +1,5 @@
-r"""Load steps solved as minimisations: the incremental potential, projected Newton and a collision-free line search.
+r"""Load steps solved as minimisations: the incremental potential, shifted or projected Newton and a collision-free
+line search.
 
 Each load step :math:`t_n \to t_{n+1}` minimises (Kane et al. 2000; Li et al. 2020, Sect. 4)
 
@@ -11,25 +12,31 @@ with :math:`\Pi = \sum_k \Pi_k` the terms' potentials (:meth:`~skvalve.fem.probl
 barrier contact, ...), :math:`M` a diagonal mass (``mass``: e.g. :func:`~skvalve.fem.damping.lumped_volume` times the
 input's density) and :math:`h` the time step; without a mass the step is the static problem, with ``velocity=False``
 :math:`\tilde u = u_n` (pseudo-mass: a proximal step that damps, whose fixed point is still the static equilibrium).
-The stationarity of :math:`E` is implicit Euler. Each iteration solves
+The stationarity of :math:`E` is implicit Euler. Each iteration solves :math:`A\,p = -\nabla E` for a descent
+direction :math:`p`, with :math:`A` chosen by ``direction``:
 
-.. math::
+* ``"shifted"`` (default; needs PARDISO's inertia): :math:`A = K_s + M/h^2 + \mu D`, the symmetric tangent with
+  Marquardt's diagonal :math:`D = |\mathrm{diag}|` and the smallest shift :math:`\mu` of :math:`0, 10^{-6}, 10^{-5},
+  \dots` for which :math:`A` is positive definite (:func:`shifted_newton`). Where the tangent is definite this is
+  Newton's step (quadratic rate near a stable minimum); where it is not, the shift stiffens every direction
+  uniformly in scale. On the Texas TriValve leaflet's papillary stage the tangent with the pseudo-mass was definite at
+  every iteration and the steps took 204 iterations against 284 projected (77 s against 152 s).
+* ``"projected"`` (also the fallback without PARDISO): :math:`A = \mathcal P[K] + M/h^2`, the tangent whose element
+  blocks (and each contact stencil, ``Contribution.projected_matrix``; a truss's own closed form, ``Blocks.projected``)
+  are projected onto their positive semidefinite parts (projected Newton: Teran et al. 2005); once the relative
+  residual is below ``newton_below`` the unprojected tangent is tried, falling back to the projected one when its
+  step is not a descent direction, and for the rest of the load step once a full-tangent step raised
+  :math:`|\nabla E|` (the two would otherwise alternate). Its rate is linear where elements are indefinite.
 
-    \big(\mathcal P[K] + M/h^2\big)\,p = -\nabla E
-
-with :math:`\mathcal P[K]` the tangent whose element blocks (and each contact stencil,
-``Contribution.projected_matrix``) are projected onto their positive semidefinite parts (projected Newton: Teran et
-al. 2005), so :math:`p` is a descent direction; once the relative residual is below ``newton_below`` the unprojected
-tangent is used (Newton's quadratic rate), falling back to the projected one when its step is not a descent
-direction. The step length starts at the terms' cap (:meth:`~skvalve.fem.problem.Problem.step_fraction`: 0.9 of the
+The step length starts at the terms' cap (:meth:`~skvalve.fem.problem.Problem.step_fraction`: 0.9 of the
 collision-free share for a barrier, so no iterate intersects) and is halved until the Armijo condition
 :math:`E(u + \alpha p) \le E(u) + c\,\alpha\,\nabla E\cdot p` holds (near convergence, where the predicted
 decrease :math:`\alpha\,\nabla E\cdot p` falls below ``ENERGY_RESOLUTION`` :math:`|E|`, a step is accepted when the
-gradient's norm falls). Where a term has no potential (a follower
-pressure on an open surface is not conservative) the merit is the residual norm instead (``energy_merit`` False in the
-history): the line search then asks that :math:`|\nabla E|` falls, and every iteration takes the unprojected tangent,
-whose direction is a descent direction of :math:`|\nabla E|` by construction (a projected one need not be: on the
-valve it took steps of 1/8 for tens of iterations).
+gradient's norm falls); a step that ends far past the minimum along :math:`p` (Wolfe's curvature condition fails)
+is moved to the zero of the slope's secant. Where a term has no potential (a follower pressure on an open surface is
+not conservative) the merit is the residual norm instead (``energy_merit`` False in the history): the line search
+then asks that :math:`|\nabla E|` falls, and every iteration takes the unprojected tangent, whose direction is a
+descent direction of :math:`|\nabla E|` by construction.
 Converged: :math:`\lVert \nabla E_f\rVert \le \max(\text{rtol}\,f_\text{ref}, \text{atol})` (Newton's measure).
 """
 
@@ -52,9 +59,17 @@ from .problem import Problem, Tangent
 from .result import Result
 from .trust_steps import project_psd
 
-__all__ = ["IncrementalOptions", "StepFailed", "incremental_potential", "minimise_step", "projected_tangent"]
+__all__ = ["IncrementalOptions", "StepFailed", "incremental_potential", "minimise_step", "projected_tangent",
+           "shifted_newton"]
 
 logger = logging.getLogger("skvalve.fem")
+
+#: How an energy-merit iteration finds its descent direction (module docstring)
+DIRECTIONS = ("projected", "shifted")
+#: the shifted direction's first shift and its growth after a factorisation with a negative pivot
+FIRST_SHIFT, SHIFT_GROWTH = 1e-6, 10.0
+#: below this last shift the next iteration tries Newton's step first (else a hundredth of the last shift)
+NEWTON_AGAIN_BELOW = 1e-3
 
 #: Relative size below which a predicted change of the total potential is lost in its rounding (a sum over every
 #: quadrature point and barrier stencil): the line search then asks that the gradient's norm falls instead.
@@ -76,15 +91,20 @@ class IncrementalOptions:
     predictor: bool = True
     stall_alpha: float = 1.0 / 16.0
     stall_iterations: int = 3
+    direction: str = "shifted"
+    curvature: float = 0.9
+    secant_steps: int = 2
 
     def __post_init__(self) -> None:
-        for name in ("rtol", "newton_below", "armijo", "stall_alpha"):
+        for name in ("rtol", "newton_below", "armijo", "stall_alpha", "curvature"):
             value = getattr(self, name)
             if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0.0):
                 raise ValueError(f"{name} must be a finite number >= 0; got {value!r}")
         if not self.rtol > 0.0:
             raise ValueError(f"rtol must be positive; got {self.rtol!r}")
-        for name in ("max_iter", "max_cutbacks", "max_line_search", "stall_iterations"):
+        if self.direction not in DIRECTIONS:
+            raise ValueError(f"direction must be one of {DIRECTIONS}; got {self.direction!r}")
+        for name in ("max_iter", "max_cutbacks", "max_line_search", "stall_iterations", "secant_steps"):
             value = getattr(self, name)
             if not isinstance(value, int) or isinstance(value, bool) or value < (1 if name == "max_iter" else 0):
                 raise ValueError(f"{name} must be a non-negative integer (max_iter >= 1); got {value!r}")
@@ -219,22 +239,31 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
     value = merit(u, gradient)
     history = []
     short = 0
+    newton_allowed = True  # False once a full-tangent step raised |grad E| (a non-convex region: stay projected)
+    shifted = energy_merit and opts.direction == "shifted" and solver == "pardiso"
+    shift = 0.0
     for iteration in range(1, opts.max_iter + 1):
         reference = reference_force(problem, residual, fixed)
         norm = float(np.linalg.norm(gradient[free]))
         if norm <= max(opts.rtol * reference, opts.atol):
             return u, residual, history
         clock = time.perf_counter()
-        # the residual norm as merit: Newton's direction is a descent direction of |grad E| by construction (the
-        # projected one need not be); the energy as merit: projected Newton until close
-        newton = norm <= opts.newton_below * reference or not energy_merit
-        K = problem.tangent_matrix(tangent) if newton else projected_tangent(problem, tangent)
-        K = K + sp.diags(inertia[free], format="csr")
-        direction = linsolve.solve(K, -gradient[free], solver, symmetric=problem.symmetric or not newton)
-        if newton and energy_merit and not float(direction @ gradient[free]) < 0.0:  # not descent: projected
-            newton = False
-            K = projected_tangent(problem, tangent) + sp.diags(inertia[free], format="csr")
-            direction = linsolve.solve(K, -gradient[free], solver, symmetric=True)
+        if shifted:
+            K = problem.tangent_matrix(tangent)  # symmetric where every term has a potential (energy merit)
+            H = 0.5 * (K + K.T) + sp.diags(inertia[free], format="csr")
+            direction, shift = shifted_newton(H, -gradient[free], shift, solver)
+            newton = shift == 0.0
+        else:
+            # the residual norm as merit: Newton's direction is a descent direction of |grad E| by construction (the
+            # projected one need not be); the energy as merit: projected Newton until close
+            newton = (newton_allowed and norm <= opts.newton_below * reference) or not energy_merit
+            K = problem.tangent_matrix(tangent) if newton else projected_tangent(problem, tangent)
+            K = K + sp.diags(inertia[free], format="csr")
+            direction = linsolve.solve(K, -gradient[free], solver, symmetric=problem.symmetric or not newton)
+            if newton and energy_merit and not float(direction @ gradient[free]) < 0.0:  # not descent: projected
+                newton = False
+                K = projected_tangent(problem, tangent) + sp.diags(inertia[free], format="csr")
+                direction = linsolve.solve(K, -gradient[free], solver, symmetric=True)
         p = np.zeros_like(u)
         p[free] = direction
         cap = problem.step_fraction(u, t_new, u + p, t_new)
@@ -258,25 +287,81 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
                 ok = trial_value <= (1.0 - opts.armijo * alpha) * value
             if ok and np.isfinite(trial_value):
                 accepted = (trial, trial_residual, trial_tangent, trial_gradient, trial_value)
+                if energy_merit and abs(alpha * slope) > ENERGY_RESOLUTION * abs(value):
+                    alpha, accepted = _past_the_minimum(problem, u, p, alpha, slope, value, accepted, t_new, step,
+                                                        inertia, predictor, merit, opts)
                 break
             alpha *= 0.5
         if accepted is None:
             raise StepFailed(f"line search: no decrease of the {'energy' if energy_merit else 'residual'} along the "
                               f"step (iteration {iteration}, relative residual {norm / reference:.3e})")
+        if newton and energy_merit and not shifted and np.linalg.norm(accepted[3][free]) > norm:
+            newton_allowed = False
         u, residual, tangent, gradient, value = accepted
         short = short + 1 if alpha <= opts.stall_alpha * cap else 0
         if short >= opts.stall_iterations:
             raise StepFailed(f"line search: {short} iterations in a row took at most {opts.stall_alpha:g} of the step "
                              f"(iteration {iteration}): a shorter load step is cheaper")
         logger.debug("step %d iteration %d: alpha %.3g (cap %.3g), %s, relative residual %.3e", step, iteration,
-                     alpha, cap, "newton" if newton else "projected", float(np.linalg.norm(gradient[free])) / reference)
+                     alpha, cap, "newton" if newton else (f"shift {shift:.2g}" if shifted else "projected"),
+                     float(np.linalg.norm(gradient[free])) / reference)
         history.append({"step": step, "load_factor": t_new, "iteration": iteration, "alpha": alpha, "cap": cap,
-                        "newton": newton, "energy_merit": energy_merit,
+                        "newton": newton, "shift": shift, "energy_merit": energy_merit,
                         "residual": float(np.linalg.norm(gradient[free])),
                         "relative_residual": float(np.linalg.norm(gradient[free])) / reference,
                         "seconds": time.perf_counter() - clock})
     raise StepFailed(f"no convergence in {opts.max_iter} iterations (relative residual "
                       f"{float(np.linalg.norm(gradient[free])) / reference_force(problem, residual, fixed):.3e})")
+
+
+def _past_the_minimum(problem: Problem, u: np.ndarray, p: np.ndarray, alpha: float, slope: float, value: float,
+                      accepted: tuple, t: float, step: int, inertia: np.ndarray, predictor: np.ndarray, merit,
+                      opts: IncrementalOptions) -> tuple[float, tuple]:
+    r"""The curvature condition of Wolfe: a step that decreased the energy but ended far past the minimum along
+    :math:`p` (slope :math:`\nabla E(u + \alpha p)\cdot p > c_2\,|\nabla E(u)\cdot p|`) is moved to the zero of the
+    slope's secant between 0 and :math:`\alpha` (at most ``opts.secant_steps`` times; kept where the energy is lower).
+    Without it Newton's iterates on stiffening cables (a chordae branch point between slack and taut branches)
+    cycle about the minimum with full steps that each pass the Armijo test."""
+    free = problem.pattern.free
+    for _ in range(opts.secant_steps):
+        trial_slope = float(accepted[3][free] @ p[free])
+        if trial_slope <= opts.curvature * abs(slope):
+            break
+        secant = alpha * (-slope) / (trial_slope - slope)
+        trial = u + secant * p
+        try:
+            residual, tangent = problem.assemble(trial, t, tangent=True, step=step)
+        except NonPositiveJacobianError:
+            break
+        gradient = residual + inertia * (trial - predictor)
+        trial_value = merit(trial, gradient)
+        if not (np.isfinite(trial_value) and trial_value <= value + opts.armijo * secant * slope
+                and trial_value < accepted[4]):
+            break
+        alpha, accepted = secant, (trial, residual, tangent, gradient, trial_value)
+    return alpha, accepted
+
+
+def shifted_newton(H: sp.spmatrix, rhs: np.ndarray, shift: float, solver: str) -> tuple[np.ndarray, float]:
+    r"""The direction :math:`p = (H + \mu D)^{-1}\,\text{rhs}` with Marquardt's diagonal :math:`D = |\text{diag}\,H|`
+    and the smallest shift :math:`\mu` of the sequence :math:`0, \mu_0, 10\mu_0, \dots` (starting from a hundredth
+    of the last iteration's ``shift``, or from 0 when it was below ``NEWTON_AGAIN_BELOW``) for which
+    :math:`H + \mu D` is positive definite (PARDISO's inertia); returns ``(p, mu)``. A positive definite matrix
+    makes ``p`` a descent direction, and :math:`\mu = 0` is Newton's step, so the iteration is quadratic near a
+    stable minimum (the per-element projection is linear there)."""
+    H = sp.csr_matrix(H)
+    scale = np.abs(H.diagonal())
+    scale = np.maximum(scale, 1e-12 * scale.max(initial=0.0))
+    diagonal = H.diagonal()
+    trial = 0.0 if shift < NEWTON_AGAIN_BELOW else shift / SHIFT_GROWTH**2
+    for _ in range(40):
+        matrix = H.copy()
+        matrix.setdiag(diagonal + trial * scale)  # the pattern stays (a diagonal entry shifted to 0 is kept)
+        direction = linsolve.solve_if_definite(matrix, rhs, solver)
+        if direction is not None:
+            return direction, trial
+        trial = FIRST_SHIFT if trial == 0.0 else SHIFT_GROWTH * trial
+    raise StepFailed(f"no shift up to {trial:.3g} x diag(H) makes the tangent positive definite")
 
 
 def _consistent_predictor(problem: Problem, u_old: np.ndarray, u: np.ndarray, t_new: float, predictor: np.ndarray,

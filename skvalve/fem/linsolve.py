@@ -48,7 +48,7 @@ import scipy.sparse.linalg as spla
 
 __all__ = [
     "LinearSolver", "SolverStatistics", "SolverUnavailableError", "SlowSolverWarning", "solve", "solver_name",
-    "available_solvers", "clear_cache",
+    "available_solvers", "cached_solver", "clear_cache", "solve_if_definite",
 ]
 
 #: PARDISO's ``iparm[33]``: the thread count whose reduction order every factorisation follows, whatever the
@@ -412,13 +412,43 @@ def solve(matrix: sp.spmatrix, rhs: np.ndarray, solver: str | None = None, symme
     ``symmetric=True`` promises ``matrix == matrix.T``. Raises ``np.linalg.LinAlgError`` when the
     system is singular or the result is not finite. :func:`clear_cache` frees the kept factors.
     """
-    name = solver_name(solver)
     csr = sp.csr_matrix(matrix)
     csr.sort_indices()
-    key = (name, bool(symmetric))
-    if key not in _CACHE.solvers:
-        _CACHE.solvers[key] = LinearSolver(name, symmetric)
-    linear = _CACHE.solvers[key]
+    linear = cached_solver(solver, symmetric)
     linear.analyse((csr.indptr, csr.indices))
     linear.factorize(csr.data)
     return linear.solve(rhs)
+
+
+def cached_solver(solver: str | None = None, symmetric: bool = False) -> LinearSolver:
+    """The :class:`LinearSolver` that :func:`solve` keeps for ``(solver, symmetric)`` in this thread."""
+    key = (solver_name(solver), bool(symmetric))
+    if key not in _CACHE.solvers:
+        _CACHE.solvers[key] = LinearSolver(key[0], key[1])
+    return _CACHE.solvers[key]
+
+
+def solve_if_definite(matrix: sp.spmatrix, rhs: np.ndarray, solver: str | None = None) -> np.ndarray | None:
+    """``x`` with ``matrix @ x = rhs`` for a symmetric ``matrix`` that is positive definite, ``None`` when its
+    :math:`LDL^T` factorisation shows a negative pivot (Sylvester's inertia: PARDISO) or a zero one (which PARDISO
+    perturbs and counts in ``iparm[13]``), or it is singular.
+    Raises :class:`SolverUnavailableError` with a backend that reports no inertia (SciPy's SuperLU)."""
+    linear = cached_solver(solver, symmetric=True)
+    if linear.name != "pardiso":
+        raise SolverUnavailableError(f"solve_if_definite needs PARDISO's inertia; the backend is {linear.name!r}")
+    csr = sp.csr_matrix(matrix)
+    csr.sort_indices()
+    linear.analyse((csr.indptr, csr.indices))
+    try:
+        linear.factorize(csr.data)
+    except np.linalg.LinAlgError:
+        return None
+    positive, negative = linear.inertia()
+    perturbed = int(linear._pardiso.iparm[13]) if linear._pardiso is not None else 0  # zero pivots PARDISO replaced
+    if negative > 0 or positive < linear.n or perturbed > 0:
+        return None
+    try:
+        return linear.solve(rhs)
+    except np.linalg.LinAlgError:
+        return None
+

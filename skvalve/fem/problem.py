@@ -230,8 +230,9 @@ class Problem:
 
         ``blocks(term, matrices) -> matrices`` and ``matrix(term, sparse) -> sparse``, when given, replace each term's
         element blocks and extra matrix before they are added (e.g. their symmetric parts, or blocks projected onto
-        positive semidefinite ones: :func:`skvalve.fem.trust_region.step_matrix`). ``projected``: a term's extra
-        matrix is replaced by its own PSD projection where it gives one (``Contribution.projected_matrix``).
+        positive semidefinite ones: :func:`skvalve.fem.trust_region.step_matrix`). ``projected``: a term's blocks and
+        extra matrix are replaced by its own PSD projections where it gives them (``Blocks.projected``,
+        ``Contribution.projected_matrix``).
         """
         pat = self.pattern
         data = np.zeros(pat.indices.size)
@@ -241,7 +242,10 @@ class Problem:
                 if block.matrices is None:
                     raise ValueError("tangent_matrix needs contributions assembled with tangent=True")
                 if pos.size:
-                    matrices = block.matrices if blocks is None else blocks(term, block.matrices)
+                    if projected and block.projected is not None:
+                        matrices = block.projected
+                    else:
+                        matrices = block.matrices if blocks is None else blocks(term, block.matrices)
                     scatter_add(np.ascontiguousarray(matrices), pos, data)
             if contribution.matrix is not None:
                 own = contribution.matrix

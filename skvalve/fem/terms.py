@@ -40,10 +40,14 @@ class Blocks:
     dofs : (n, m) int array of global dof numbers.
     matrices : (n, m, m) array of :math:`\partial R_{dofs[e, a]}/\partial u_{dofs[e, b]}`, or None
         when no tangent was requested.
+    projected : (n, m, m) positive semidefinite blocks the term derives itself (e.g. in closed form), used instead
+        of an eigendecomposition of ``matrices`` by projected Newton steps
+        (:meth:`~skvalve.fem.problem.Problem.tangent_matrix` ``projected=True``); None: project ``matrices``.
     """
 
     dofs: np.ndarray
     matrices: np.ndarray | None = None
+    projected: np.ndarray | None = None
 
 
 @dataclass

@@ -56,13 +56,15 @@ class BarEnd:
 
 @dataclass
 class BarResponse:
-    """Per-bar state: stretch, axial force and current length; element forces (n, 6) and tangents (n, 6, 6)."""
+    """Per-bar state: stretch, axial force and current length; element forces (n, 6) and tangents (n, 6, 6), and
+    the tangents' positive semidefinite projections (:func:`bar_response`)."""
 
     stretch: np.ndarray
     axial_force: np.ndarray
     length: np.ndarray
     forces: np.ndarray
     matrices: np.ndarray | None
+    projected: np.ndarray | None = None
 
 
 class LawAssignment:
@@ -127,11 +129,17 @@ class LawAssignment:
 def bar_response(x_a: np.ndarray, x_b: np.ndarray, rest_length: np.ndarray, area: np.ndarray,
                  laws: LawAssignment, tangent: bool = True, slack_stretch: np.ndarray | None = None,
                  scale: float = 1.0) -> BarResponse:
-    """Forces and tangents of bars with current end positions ``x_a, x_b`` of shape (n, 3) (module docstring).
+    r"""Forces and tangents of bars with current end positions ``x_a, x_b`` of shape (n, 3) (module docstring).
 
     ``slack_stretch``: per-bar force-free stretch of tension-only laws
     (:class:`~skvalve.materials.uniaxial.TensionOnly`).
     Raises ``ValueError`` naming the bars whose current length is zero or not finite.
+
+    The tangent of a bar is :math:`\begin{bmatrix} k & -k\\ -k & k\end{bmatrix}`, :math:`k = a\,nn^T +
+    b\,(I - nn^T)` with the axial stiffness :math:`a = A\,P'(\lambda)/L` and the geometric one :math:`b = N/l`:
+    its eigenvalues are :math:`2a` (stretching), :math:`2b` (twice: rotation) and 0 (three translations). Its
+    projection onto the positive semidefinite matrices (``projected``, for projected Newton steps) therefore sets
+    :math:`a \to \max(a, 0)` and :math:`b \to \max(b, 0)`: a closed form, no eigendecomposition.
     """
     d = x_b - x_a
     length = np.linalg.norm(d, axis=1)
@@ -144,16 +152,24 @@ def bar_response(x_a: np.ndarray, x_b: np.ndarray, rest_length: np.ndarray, area
     N = area * P
     f = N[:, None] * n
     forces = np.hstack([-f, f])
-    matrices = None
+    matrices = projected = None
     if tangent:
         nn = n[:, :, None] * n[:, None, :]
-        k = (area * dP / rest_length)[:, None, None] * nn + (N / length)[:, None, None] * (np.eye(3) - nn)
-        matrices = np.empty((n.shape[0], 6, 6))
-        matrices[:, :3, :3] = k
-        matrices[:, 3:, 3:] = k
-        matrices[:, :3, 3:] = -k
-        matrices[:, 3:, :3] = -k
-    return BarResponse(stretch, N, length, forces, matrices)
+        axial, geometric = area * dP / rest_length, N / length
+        matrices = _bar_matrices(axial, geometric, nn)
+        projected = _bar_matrices(np.maximum(axial, 0.0), np.maximum(geometric, 0.0), nn)
+    return BarResponse(stretch, N, length, forces, matrices, projected)
+
+
+def _bar_matrices(axial: np.ndarray, geometric: np.ndarray, nn: np.ndarray) -> np.ndarray:
+    """(n, 6, 6) bar tangents from the axial and geometric stiffnesses and the axis dyads (:func:`bar_response`)."""
+    k = axial[:, None, None] * nn + geometric[:, None, None] * (np.eye(3) - nn)
+    matrices = np.empty((k.shape[0], 6, 6))
+    matrices[:, :3, :3] = k
+    matrices[:, 3:, 3:] = k
+    matrices[:, :3, 3:] = -k
+    matrices[:, 3:, :3] = -k
+    return matrices
 
 
 class Truss(Term):
@@ -246,6 +262,7 @@ class Truss(Term):
         state.forces = np.matmul(spread_t, state.forces[:, :, None])[:, :, 0]
         if state.matrices is not None:
             state.matrices = np.matmul(np.matmul(spread_t, state.matrices), spread)
+            state.projected = np.matmul(np.matmul(spread_t, state.projected), spread)
         return state
 
     def _scale(self, t: float, step: int | None) -> float:
@@ -273,7 +290,7 @@ class Truss(Term):
         except ValueError as err:
             raise ValueError(f"{err} (load step {step}, load factor {t})") from err
         internal = np.bincount(self.dofs.ravel(), state.forces.ravel(), minlength=self.space.n_dofs)
-        return Contribution(internal=internal, blocks=[Blocks(self.dofs, state.matrices)])
+        return Contribution(internal=internal, blocks=[Blocks(self.dofs, state.matrices, state.projected)])
 
 
 def _bar_ends(nodes, name: str, n_scalar: int) -> tuple[BarEnd, BarEnd]:

@@ -1,0 +1,126 @@
+"""Descent directions and line search of the incremental-potential steps (:mod:`skvalve.fem.incremental`).
+
+The shifted Newton direction: Newton's step where the tangent is positive definite, the smallest Marquardt shift of
+the sequence where it is not (checked against the eigenvalues), a quadratic rate near a stable minimum where the
+per-element projection is linear; the Wolfe curvature refinement: a step far past the minimum along its direction is
+moved onto the minimum of a quadratic (closed form); both directions reach the same equilibrium with IPC contact.
+"""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from test_ipc_contact import _block_over_obstacle  # the pressed block of the IPC tests
+
+from skvalve.fem import linsolve
+from skvalve.fem.incremental import (
+    FIRST_SHIFT,
+    SHIFT_GROWTH,
+    IncrementalOptions,
+    _past_the_minimum,
+    incremental_potential,
+    shifted_newton,
+)
+
+pytestmark = pytest.mark.skipif("pardiso" not in linsolve.available_solvers(), reason="needs PARDISO's inertia")
+
+
+def _laplacian(n: int, shift: float) -> sp.csr_matrix:
+    return sp.diags([-np.ones(n - 1), np.full(n, 2.0 + shift), -np.ones(n - 1)], [-1, 0, 1], format="csr")
+
+
+def test_shifted_newton_is_newton_on_a_definite_matrix():
+    H = _laplacian(30, 0.1)
+    rhs = np.random.default_rng(0).standard_normal(30)
+    direction, shift = shifted_newton(H, rhs, 0.0, "pardiso")
+    assert shift == 0.0
+    np.testing.assert_allclose(direction, np.linalg.solve(H.toarray(), rhs), rtol=1e-10)
+
+
+def test_shifted_newton_takes_the_smallest_definite_shift_of_its_sequence():
+    """lambda_min(H) = -0.3 at a diagonal of ~2: the shift is the first mu of 1e-6 x 10^k with H + mu diag(H) > 0."""
+    H = _laplacian(30, -0.3)
+    rhs = np.random.default_rng(1).standard_normal(30)
+    direction, shift = shifted_newton(H, rhs, 0.0, "pardiso")
+    D = np.abs(H.diagonal())
+    lowest = lambda mu: np.linalg.eigvalsh(H.toarray() + mu * np.diag(D))[0]
+    assert lowest(shift) > 0.0 and lowest(shift / SHIFT_GROWTH) <= 0.0
+    assert np.log10(shift / FIRST_SHIFT) == pytest.approx(round(np.log10(shift / FIRST_SHIFT)))
+    assert rhs @ direction > 0.0  # a descent direction for the gradient -rhs
+    # warm start: from a larger last shift the sequence starts a hundredth below it and ends at a definite one
+    _, again = shifted_newton(H, rhs, 1e3 * shift, "pardiso")
+    assert again == pytest.approx(10 * shift) and lowest(again) > 0.0
+
+
+def test_a_negative_pivot_is_lifted_by_its_own_diagonal():
+    """diag(1, -1, 2): definite once mu |diag| lifts the -1 past 0, so mu = 10 (mu = 1 makes it singular)."""
+    H = sp.csr_matrix(np.diag([1.0, -1.0, 2.0]))
+    direction, shift = shifted_newton(H, np.ones(3), 0.0, "pardiso")
+    assert shift == pytest.approx(10.0)
+    np.testing.assert_allclose(direction, [1.0 / 11.0, 1.0 / 9.0, 1.0 / 22.0], rtol=1e-12)
+
+
+class _Quadratic:
+    """E(u) = k/2 |u - u*|^2 on free dofs: a stand-in problem for the line search."""
+
+    def __init__(self, k: float, target: np.ndarray) -> None:
+        self.k, self.target = k, target
+        self.pattern = SimpleNamespace(free=np.arange(target.size))
+
+    def assemble(self, u, t, tangent=True, step=None):
+        return self.k * (u - self.target), None
+
+    def energy(self, u):
+        return 0.5 * self.k * float((u - self.target) @ (u - self.target))
+
+
+def test_a_step_far_past_the_minimum_is_moved_onto_it():
+    """Along p = 1.95 (u* - u) the full step decreases E (Armijo holds) but ends with a slope of 0.95 |slope(0)|:
+    the curvature condition moves it to the secant's zero, the exact minimiser of a quadratic (alpha = 1/1.95)."""
+    target = np.array([1.0, -2.0, 0.5])
+    problem = _Quadratic(3.0, target)
+    u = np.zeros(3)
+    p = 1.95 * (target - u)
+    gradient = problem.assemble(u, 0.0)[0]
+    slope, value = float(gradient @ p), problem.energy(u)
+    full = u + p
+    accepted = (full, problem.assemble(full, 0.0)[0], None, problem.assemble(full, 0.0)[0], problem.energy(full))
+    assert accepted[4] <= value + 1e-4 * slope  # Armijo accepts the overshoot
+    merit = lambda state, g: problem.energy(state)
+    alpha, refined = _past_the_minimum(problem, u, p, 1.0, slope, value, accepted, 0.0, 1, np.zeros(3), u, merit,
+                                       IncrementalOptions())
+    assert alpha == pytest.approx(1.0 / 1.95, rel=1e-12)
+    np.testing.assert_allclose(refined[0], target, atol=1e-12)
+    # a step that stops short of the minimum is left as it is
+    short = u + 0.5 * (target - u)
+    kept = (short, problem.assemble(short, 0.0)[0], None, problem.assemble(short, 0.0)[0], problem.energy(short))
+    assert _past_the_minimum(problem, u, target - u, 0.5, float(gradient @ (target - u)), value, kept, 0.0, 1,
+                             np.zeros(3), u, merit, IncrementalOptions())[0] == 0.5
+
+
+def _pressed_block(direction: str):
+    solid, contact, _ = _block_over_obstacle(drop=0.1, gap=0.05, dhat=0.02, rollers=True)
+    result = incremental_potential(solid, steps=2, options=IncrementalOptions(rtol=1e-10, atol=1e-12,
+                                                                              direction=direction), progress=False)
+    return result, contact
+
+
+def test_both_directions_reach_the_same_contact_equilibrium_and_shifted_newton_ends_quadratically():
+    """The block pressed onto an obstacle on rollers (one equilibrium, as the IPC tests show against Newton)."""
+    projected, _ = _pressed_block("projected")
+    shifted, contact = _pressed_block("shifted")
+    u = shifted.solutions[-1]
+    assert np.abs(u - projected.solutions[-1]).max() <= 1e-7 * np.abs(u).max()
+    assert not contact.intersects(u, 1.0)
+    last = [record["relative_residual"] for record in shifted.histories[-1]]
+    # the residual falls at a rate of order 2 once it is small: log r_{k+1} / log r_k > 1.6
+    rates = [np.log(c) / np.log(b) for b, c in zip(last[:-1], last[1:], strict=True) if b < 1e-2]
+    assert rates and max(rates) > 1.6, last
+    assert shifted.histories[-1][-1]["shift"] == 0.0
+    assert sum(map(len, shifted.histories)) <= sum(map(len, projected.histories))
+
+
+def test_unknown_direction_is_named():
+    with pytest.raises(ValueError, match="direction"):
+        IncrementalOptions(direction="steepest")
