@@ -13,7 +13,7 @@ import pytest
 import scipy.sparse as sp
 from test_ipc_contact import _block_over_obstacle  # the pressed block of the IPC tests
 
-from skvalve.fem import linsolve
+from skvalve.fem import Solid, linsolve, solve
 from skvalve.fem.incremental import (
     FIRST_SHIFT,
     SHIFT_GROWTH,
@@ -22,6 +22,8 @@ from skvalve.fem.incremental import (
     incremental_potential,
     shifted_newton,
 )
+from skvalve.fem.meshes import box
+from skvalve.materials import NeoHookean
 
 pytestmark = pytest.mark.skipif("pardiso" not in linsolve.available_solvers(), reason="needs PARDISO's inertia")
 
@@ -69,7 +71,7 @@ class _Quadratic:
         self.pattern = SimpleNamespace(free=np.arange(target.size))
 
     def assemble(self, u, t, tangent=True, step=None):
-        return self.k * (u - self.target), None
+        return self.k * (u - self.target), SimpleNamespace(contributions=[])
 
     def energy(self, u):
         return 0.5 * self.k * float((u - self.target) @ (u - self.target))
@@ -87,7 +89,7 @@ def test_a_step_far_past_the_minimum_is_moved_onto_it():
     full = u + p
     accepted = (full, problem.assemble(full, 0.0)[0], None, problem.assemble(full, 0.0)[0], problem.energy(full))
     assert accepted[4] <= value + 1e-4 * slope  # Armijo accepts the overshoot
-    merit = lambda state, g: problem.energy(state)
+    merit = lambda alpha, state, contributions: problem.energy(state)
     alpha, refined = _past_the_minimum(problem, u, p, 1.0, slope, value, accepted, 0.0, 1, np.zeros(3), u, merit,
                                        IncrementalOptions())
     assert alpha == pytest.approx(1.0 / 1.95, rel=1e-12)
@@ -124,3 +126,27 @@ def test_both_directions_reach_the_same_contact_equilibrium_and_shifted_newton_e
 def test_unknown_direction_is_named():
     with pytest.raises(ValueError, match="direction"):
         IncrementalOptions(direction="steepest")
+
+
+def _bent_strip(solver):
+    """A strip clamped at x = 0 and bent by a follower pressure on its underside: the pressure turns with the
+    strip, a load without a potential (its tangent is not symmetric)."""
+    solid = Solid(box((6, 1, 1), (1.0, 0.2, 0.05)), NeoHookean(1.0, 20.0))
+    solid.add_dirichlet(lambda X: X[0] < 1e-9, 0.0)
+    solid.add_pressure(lambda x: x[2] < 1e-9, 2e-3)
+    return solver(solid)
+
+
+def test_a_follower_pressure_step_is_minimised_along_each_ray_to_newtons_equilibrium():
+    """With a term that has no potential the line search follows phi(alpha) = potential + the term's work along the
+    ray (trapezoidal): it reaches the equilibrium Newton's method finds, and its last iterations take full Newton
+    steps (quadratic rate)."""
+    newton = _bent_strip(lambda s: solve(s, steps=4, rtol=1e-11, progress=False))
+    minimised = _bent_strip(lambda s: incremental_potential(s, steps=4, options=IncrementalOptions(rtol=1e-11),
+                                                            progress=False))
+    u = minimised.solutions[-1]
+    assert np.abs(u).max() > 0.05  # a large deflection: the pressure has turned
+    assert np.abs(u - newton.solutions[-1]).max() <= 1e-8 * np.abs(u).max()
+    records = [record for step in minimised.histories for record in step]
+    assert not any(record["energy_merit"] for record in records)
+    assert records[-1]["newton"] and records[-1]["alpha"] == 1.0

@@ -222,25 +222,32 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
     if problem.step_fraction(u_old, t_old, u, t_new) < 1.0:
         raise StepFailed(f"the prescribed motion from load factor {t_old:.6g} to {t_new:.6g} is not collision-free")
 
-    energy_merit = problem.energy(u, t_new) is not None  # else the residual norm (module docstring)
+    work = _work_terms(problem, u, t_new)  # terms without a potential: their work is integrated along each ray
+    energy_merit = not work
     if opts.predictor and fixed.size and np.any(u[fixed] != u_old[fixed]):
         u = _consistent_predictor(problem, u_old, u, t_new, predictor, inertia, step, solver, energy_merit)
     residual, tangent = problem.assemble(u, t_new, tangent=True, step=step)
     gradient = residual + inertia * (u - predictor)
 
-    def merit(state: np.ndarray, gradient: np.ndarray) -> float:
-        """The incremental potential at ``state``, or the norm of its gradient where a term has no potential."""
-        if not energy_merit:
-            return float(np.linalg.norm(gradient[free]))
+    def potential(state: np.ndarray) -> float:
+        """The potential part of the incremental potential at ``state`` (+inf where a term refuses the state)."""
         d = state - predictor
-        energy = problem.energy(state, t_new)
-        return float("inf") if energy is None else energy + 0.5 * float(d @ (inertia * d))
+        total = 0.5 * float(d @ (inertia * d))
+        for k, term in enumerate(problem.terms):
+            if k not in work:
+                total += float(term.energy(state, t_new))
+        return total
 
-    value = merit(u, gradient)
+    def work_force(contributions) -> np.ndarray:
+        force = np.zeros(problem.space.n_dofs)
+        for k in work:
+            force += contributions[k].residual(problem.space.n_dofs)
+        return force
+
     history = []
     short = 0
     newton_allowed = True  # False once a full-tangent step raised |grad E| (a non-convex region: stay projected)
-    shifted = energy_merit and opts.direction == "shifted" and solver == "pardiso"
+    shifted = opts.direction == "shifted" and solver == "pardiso"
     shift = 0.0
     for iteration in range(1, opts.max_iter + 1):
         reference = reference_force(problem, residual, fixed)
@@ -249,55 +256,40 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
             return u, residual, history
         clock = time.perf_counter()
         if shifted:
-            K = problem.tangent_matrix(tangent)  # symmetric where every term has a potential (energy merit)
-            H = 0.5 * (K + K.T) + sp.diags(inertia[free], format="csr")
+            K = problem.tangent_matrix(tangent)
+            H = 0.5 * (K + K.T) + sp.diags(inertia[free], format="csr")  # K itself where every term has a potential
             direction, shift = shifted_newton(H, -gradient[free], shift, solver)
-            newton = shift == 0.0
+            newton = shift == 0.0 and energy_merit
+            if shift < NEWTON_AGAIN_BELOW and not energy_merit and norm <= opts.newton_below * reference:
+                # near the solution: the full (non-symmetric) tangent for Newton's rate, where it points downhill
+                full = linsolve.solve(K + sp.diags(inertia[free], format="csr"), -gradient[free], solver)
+                if float(full @ gradient[free]) < 0.0:
+                    direction, newton = full, True
         else:
-            # the residual norm as merit: Newton's direction is a descent direction of |grad E| by construction (the
-            # projected one need not be); the energy as merit: projected Newton until close
+            # without a potential: Newton's direction (the projected one need not lower |grad E|); with one:
+            # projected Newton until close
             newton = (newton_allowed and norm <= opts.newton_below * reference) or not energy_merit
             K = problem.tangent_matrix(tangent) if newton else projected_tangent(problem, tangent)
             K = K + sp.diags(inertia[free], format="csr")
             direction = linsolve.solve(K, -gradient[free], solver, symmetric=problem.symmetric or not newton)
-            if newton and energy_merit and not float(direction @ gradient[free]) < 0.0:  # not descent: projected
+            if newton and not float(direction @ gradient[free]) < 0.0:  # not descent: projected
                 newton = False
                 K = projected_tangent(problem, tangent) + sp.diags(inertia[free], format="csr")
                 direction = linsolve.solve(K, -gradient[free], solver, symmetric=True)
         p = np.zeros_like(u)
         p[free] = direction
         cap = problem.step_fraction(u, t_new, u + p, t_new)
-        alpha, slope = cap, float(direction @ gradient[free])
-        accepted = None
-        for _ in range(opts.max_line_search + 1):
-            trial = u + alpha * p
-            try:
-                trial_residual, trial_tangent = problem.assemble(trial, t_new, tangent=True, step=step)
-            except NonPositiveJacobianError:
-                alpha *= 0.5
-                continue
-            trial_gradient = trial_residual + inertia * (trial - predictor)
-            trial_value = merit(trial, trial_gradient)
-            if energy_merit and abs(alpha * slope) > ENERGY_RESOLUTION * abs(value):
-                ok = trial_value <= value + opts.armijo * alpha * slope
-            elif energy_merit:  # the decrease is below the energy's rounding: the gradient's norm decides
-                ok = (np.linalg.norm(trial_gradient[free]) < np.linalg.norm(gradient[free])
-                      and trial_value <= value + ENERGY_RESOLUTION * abs(value))
-            else:
-                ok = trial_value <= (1.0 - opts.armijo * alpha) * value
-            if ok and np.isfinite(trial_value):
-                accepted = (trial, trial_residual, trial_tangent, trial_gradient, trial_value)
-                if energy_merit and abs(alpha * slope) > ENERGY_RESOLUTION * abs(value):
-                    alpha, accepted = _past_the_minimum(problem, u, p, alpha, slope, value, accepted, t_new, step,
-                                                        inertia, predictor, merit, opts)
-                break
-            alpha *= 0.5
+        slope = float(direction @ gradient[free])
+        value = potential(u)
+        along = _Ray(potential, work_force, p, None if energy_merit else float(work_force(tangent.contributions) @ p))
+        alpha, accepted = _line_search(problem, u, p, cap, slope, value, norm, along, t_new, step, inertia,
+                                       predictor, opts)
         if accepted is None:
-            raise StepFailed(f"line search: no decrease of the {'energy' if energy_merit else 'residual'} along the "
-                              f"step (iteration {iteration}, relative residual {norm / reference:.3e})")
+            raise StepFailed(f"line search: no decrease of the {'energy' if energy_merit else 'energy and work'} "
+                             f"along the step (iteration {iteration}, relative residual {norm / reference:.3e})")
         if newton and energy_merit and not shifted and np.linalg.norm(accepted[3][free]) > norm:
             newton_allowed = False
-        u, residual, tangent, gradient, value = accepted
+        u, residual, tangent, gradient, _ = accepted
         short = short + 1 if alpha <= opts.stall_alpha * cap else 0
         if short >= opts.stall_iterations:
             raise StepFailed(f"line search: {short} iterations in a row took at most {opts.stall_alpha:g} of the step "
@@ -314,8 +306,68 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
                       f"{float(np.linalg.norm(gradient[free])) / reference_force(problem, residual, fixed):.3e})")
 
 
+@dataclass
+class _Ray:
+    r""":math:`\phi(\alpha)` along the ray :math:`u + \alpha p`: the potential terms' incremental potential at the
+    state plus the work of the terms without one from :math:`u`, by the trapezoidal rule
+    :math:`\tfrac\alpha2\,(r_w(u) + r_w(u + \alpha p))\cdot p`, so that :math:`\phi'` is the whole gradient along
+    :math:`p` (to :math:`O(\alpha^3)`); ``base_work`` :math:`r_w(u)\cdot p`, None when every term has a potential."""
+
+    potential: Callable[[np.ndarray], float]
+    work_force: Callable[[list], np.ndarray]
+    p: np.ndarray
+    base_work: float | None
+
+    def __call__(self, alpha: float, state: np.ndarray, contributions: list) -> float:
+        if self.base_work is None:
+            return self.potential(state)
+        return self.potential(state) + 0.5 * alpha * (self.base_work + float(self.work_force(contributions) @ self.p))
+
+
+def _work_terms(problem: Problem, u: np.ndarray, t: float) -> list[int]:
+    """Indices of the terms with no potential at ``(u, t)`` (``energy`` missing or ``None``)."""
+    return [k for k, term in enumerate(problem.terms)
+            if getattr(term, "energy", None) is None or term.energy(u, t) is None]
+
+
+def _line_search(problem: Problem, u: np.ndarray, p: np.ndarray, cap: float, slope: float, value: float, norm: float,
+                 along, t: float, step: int, inertia: np.ndarray, predictor: np.ndarray, opts: IncrementalOptions):
+    """Backtracking from ``cap`` until Armijo's condition holds for ``along`` (module docstring; ``norm``: the
+    gradient's norm at ``u``, the test where the energy's change is below its rounding), then Wolfe's
+    curvature refinement (:func:`_past_the_minimum`); returns ``(alpha, (state, residual, tangent, gradient,
+    value))`` or ``(alpha, None)`` when no step length decreases it."""
+    free = problem.pattern.free
+    alpha = cap
+    for _ in range(opts.max_line_search + 1):
+        trial = u + alpha * p
+        try:
+            trial_residual, trial_tangent = problem.assemble(trial, t, tangent=True, step=step)
+        except NonPositiveJacobianError:
+            alpha *= 0.5
+            continue
+        trial_gradient = trial_residual + inertia * (trial - predictor)
+        trial_value = along(alpha, trial, trial_tangent.contributions)
+        resolved = abs(alpha * slope) > ENERGY_RESOLUTION * abs(value)
+        if along.base_work is not None:  # phi's trapezoid is O(alpha^3): near a solution |grad| decides as well
+            ok = (trial_value <= value + opts.armijo * alpha * slope
+                  or np.linalg.norm(trial_gradient[free]) <= (1.0 - opts.armijo * alpha) * norm)
+        elif resolved:
+            ok = trial_value <= value + opts.armijo * alpha * slope
+        else:  # the decrease is below the energy's rounding: the gradient's norm decides
+            ok = (np.linalg.norm(trial_gradient[free]) < norm
+                  and trial_value <= value + ENERGY_RESOLUTION * abs(value))
+        if ok and np.isfinite(trial_value):
+            accepted = (trial, trial_residual, trial_tangent, trial_gradient, trial_value)
+            if resolved:
+                alpha, accepted = _past_the_minimum(problem, u, p, alpha, slope, value, accepted, t, step,
+                                                    inertia, predictor, along, opts)
+            return alpha, accepted
+        alpha *= 0.5
+    return alpha, None
+
+
 def _past_the_minimum(problem: Problem, u: np.ndarray, p: np.ndarray, alpha: float, slope: float, value: float,
-                      accepted: tuple, t: float, step: int, inertia: np.ndarray, predictor: np.ndarray, merit,
+                      accepted: tuple, t: float, step: int, inertia: np.ndarray, predictor: np.ndarray, along,
                       opts: IncrementalOptions) -> tuple[float, tuple]:
     r"""The curvature condition of Wolfe: a step that decreased the energy but ended far past the minimum along
     :math:`p` (slope :math:`\nabla E(u + \alpha p)\cdot p > c_2\,|\nabla E(u)\cdot p|`) is moved to the zero of the
@@ -334,7 +386,7 @@ def _past_the_minimum(problem: Problem, u: np.ndarray, p: np.ndarray, alpha: flo
         except NonPositiveJacobianError:
             break
         gradient = residual + inertia * (trial - predictor)
-        trial_value = merit(trial, gradient)
+        trial_value = along(secant, trial, tangent.contributions)
         if not (np.isfinite(trial_value) and trial_value <= value + opts.armijo * secant * slope
                 and trial_value < accepted[4]):
             break
