@@ -20,9 +20,10 @@ so the picture is not mirrored; faces are painted far to near (painter's algorit
   coloured by the maximum principal Cauchy stress of the hex it bounds (kPa;
   :func:`skvalve.valve.outputs.max_principal_cauchy`), the colour range the minimum and maximum shown, and the
   annulus.
-* :func:`coaptation_map`: the contact surface's faces with positive contact pressure
-  (:meth:`~skvalve.fem.contact.SurfaceContact.face_pressure`, kPa) over the valve in grey, with the coaptation
-  area (:meth:`~skvalve.fem.contact.SurfaceContact.contact_area`) in the title: seen from the atrium in the
+* :func:`coaptation_map`: the contact surface's faces all of whose nodes carry IPC barrier force (those of
+  :meth:`~skvalve.fem.contact.IPCContact.contact_area`), coloured by the mean of their nodes' contact pressure
+  (:meth:`~skvalve.fem.contact.IPCContact.nodal_pressure`, kPa) over the valve in grey, with the coaptation
+  area (their current area) in the title: seen from the atrium in the
   state itself, and, as in the paper's Fig. 7b, where they lie in the open (end-diastolic, reference)
   configuration, there on the valve unrolled about the annulus axis (:func:`unrolled`), since from the atrium
   the open leaflets, hanging nearly parallel to the axis, project onto a ring a few millimetres wide.
@@ -42,9 +43,9 @@ from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.figure import Figure
 
 from ...fem.contact import oriented_quads
-from ...valve.closure import ClosureSetup
 from ...valve.geometry import annulus_nodes, best_fit_plane, boundary_loops, leaflet_surfaces, union_surface
 from ...valve.outputs import abaqus_positions, max_principal_cauchy
+from ...valve.setup import ValveSetup
 from ..plotting import readable_style, save_figure
 from .data import CREDIT
 
@@ -115,7 +116,7 @@ def shoelace_area(polygon: np.ndarray) -> float:
     return float(0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y)))
 
 
-def _valve_surface(setup: ClosureSetup, u: np.ndarray, surface: str
+def _valve_surface(setup: ValveSetup, u: np.ndarray, surface: str
                    ) -> tuple[np.ndarray, dict[str, np.ndarray], np.ndarray]:
     """Current points and per-leaflet faces of a leaflet surface, and its annulus loop (indices into the points)."""
     x = abaqus_positions(setup, u)
@@ -130,13 +131,13 @@ def _valve_surface(setup: ClosureSetup, u: np.ndarray, surface: str
     return points, faces, min(loops, key=distance)
 
 
-def annulus_loop(setup: ClosureSetup, u: np.ndarray, surface: str = "mid") -> np.ndarray:
+def annulus_loop(setup: ValveSetup, u: np.ndarray, surface: str = "mid") -> np.ndarray:
     """Current coordinates (n, 3) of the annulus loop of a leaflet surface (module docstring), in loop order."""
     points, _, loop = _valve_surface(setup, u, surface)
     return points[loop]
 
 
-def _atrium_side(setup: ClosureSetup, u: np.ndarray, origin: np.ndarray, normal: np.ndarray) -> float:
+def _atrium_side(setup: ValveSetup, u: np.ndarray, origin: np.ndarray, normal: np.ndarray) -> float:
     """+1 if ``normal`` points to the atrium at state ``u``, else -1 (ventricular markers: module docstring)."""
     x = _current(setup, u)
     markers = x[setup.leaflet_of_vertex < 0]
@@ -148,7 +149,7 @@ def _atrium_side(setup: ClosureSetup, u: np.ndarray, origin: np.ndarray, normal:
     return -np.sign(height)
 
 
-def atrial_projection(setup: ClosureSetup, u: np.ndarray, surface: str = "mid",
+def atrial_projection(setup: ValveSetup, u: np.ndarray, surface: str = "mid",
                       loop: np.ndarray | None = None) -> AtrialProjection:
     """The view from the atrium on the best-fit plane of the current annulus loop (module docstring).
 
@@ -162,7 +163,7 @@ def atrial_projection(setup: ClosureSetup, u: np.ndarray, surface: str = "mid",
     return AtrialProjection(origin, normal, np.stack([e1, np.cross(normal, e1)]))
 
 
-def outer_faces(setup: ClosureSetup) -> tuple[np.ndarray, np.ndarray]:
+def outer_faces(setup: ValveSetup) -> tuple[np.ndarray, np.ndarray]:
     """Boundary faces of the hex mesh, cyclic and outward (n, 4) vertex indices, and the hex each bounds (n,)."""
     mesh = setup.model.mesh
     facets = mesh.boundary_facets()
@@ -171,7 +172,7 @@ def outer_faces(setup: ClosureSetup) -> tuple[np.ndarray, np.ndarray]:
     return oriented_quads(mesh.p.T, mesh.facets[:, facets].T, inside), owners
 
 
-def _current(setup: ClosureSetup, u: np.ndarray) -> np.ndarray:
+def _current(setup: ValveSetup, u: np.ndarray) -> np.ndarray:
     return setup.model.mesh.p.T + u[: setup.problem.space.n_u].reshape(-1, 3)
 
 
@@ -199,7 +200,7 @@ def _caption(fig: Figure, t: float, credit: str) -> None:
     fig.suptitle(f"model: {credit}; step time t = {t:.4g}", fontsize=9)
 
 
-def atrial_view_stress(setup: ClosureSetup, u: np.ndarray, t: float, path, credit: str = CREDIT,
+def atrial_view_stress(setup: ValveSetup, u: np.ndarray, t: float, path, credit: str = CREDIT,
                        cmap: str = "viridis", limits: tuple[float, float] | None = None,
                        upper_percentile: float | None = None) -> StressFigure:
     """The valve seen from the atrium, outer hex faces coloured by maximum principal Cauchy stress (kPa).
@@ -250,38 +251,42 @@ def unrolled(projection: AtrialProjection, corners: np.ndarray, radius: float) -
     return np.stack([radius * angle, projection.depth(corners)], axis=-1)
 
 
-def coaptation_map(setup: ClosureSetup, u: np.ndarray, t: float, path, pressure: np.ndarray | None = None,
+def coaptation_map(setup: ValveSetup, u: np.ndarray, t: float, path, pressure: np.ndarray | None = None,
                    credit: str = CREDIT, cmap: str = "Reds") -> CoaptationFigure:
     """Contact pressure (kPa) of the coapting faces: seen from the atrium, and on the unrolled open valve (Fig. 7b).
 
-    Top: the state ``u`` seen from the atrium, the valve in grey and the faces with positive contact pressure
-    in colour on top. Bottom, like the paper's Fig. 7b: the same faces where they lie in the open (end-diastolic,
-    reference) configuration, on the valve unrolled about the annulus axis (:func:`unrolled`): seen from the
-    atrium the open leaflets hang nearly parallel to the axis and project onto a thin ring.
-    ``pressure``: face pressures of the contact surface at ``u`` (MPa), default
-    ``setup.contact.face_pressure(u, t)``; the coaptation area is ``setup.contact.contact_area`` of them.
+    Top: the state ``u`` seen from the atrium, the valve in grey and the coapting faces in colour on top. Bottom,
+    like the paper's Fig. 7b: the same faces where they lie in the open (end-diastolic, reference) configuration, on
+    the valve unrolled about the annulus axis (:func:`unrolled`): seen from the atrium the open leaflets hang nearly
+    parallel to the axis and project onto a thin ring. ``pressure``: nodal contact pressures at ``u`` (MPa, one per
+    scalar node), default ``setup.contact.nodal_pressure(u, t)``. A face coapts when all its nodes carry pressure
+    and is coloured by their mean; the coaptation area is the faces' current area (that of
+    :meth:`~skvalve.fem.contact.IPCContact.contact_area`).
     """
     contact = setup.contact
-    n_faces = contact.surface.quads.shape[0]
-    pressure = contact.face_pressure(u, t) if pressure is None else np.asarray(pressure, dtype=float)
-    if pressure.shape != (n_faces,):
-        raise ValueError(f"coaptation map: face pressures of shape {pressure.shape} for {n_faces} contact faces")
-    area = contact.contact_area(u, pressure=pressure)
-    touching = np.flatnonzero(pressure > 0.0)
-    quads, _ = outer_faces(setup)
+    quads = contact.surface.quads
+    n_nodes = contact.space.n_scalar
+    pressure = contact.nodal_pressure(u, t) if pressure is None else np.asarray(pressure, dtype=float)
+    if pressure.shape != (n_nodes,):
+        raise ValueError(f"coaptation map: nodal pressures of shape {pressure.shape} for {n_nodes} nodes")
+    touching = np.flatnonzero(pressure[quads].min(axis=1) > 0.0)
+    face_pressure = pressure[quads].mean(axis=1)
     x, X = _current(setup, u), setup.model.mesh.p.T
+    Q = x[quads[touching]]
+    area = float(0.5 * np.linalg.norm(np.cross(Q[:, 2] - Q[:, 0], Q[:, 3] - Q[:, 1]), axis=1).sum())
+    valve_quads, _ = outer_faces(setup)
     ring = annulus_loop(setup, u)
     projection = atrial_projection(setup, u, loop=ring)
     reference_ring = annulus_loop(setup, np.zeros_like(u))
     reference = atrial_projection(setup, u, loop=reference_ring)
     radius = float(np.linalg.norm(reference(reference_ring), axis=1).mean())
-    valve, valve_order = _painted(projection, x[quads])
-    polygons, order = _painted(projection, x[contact.surface.quads[touching]])
-    values = pressure[touching][order] * MPA_TO_KPA
+    valve, valve_order = _painted(projection, x[valve_quads])
+    polygons, order = _painted(projection, Q)
+    values = face_pressure[touching][order] * MPA_TO_KPA
     # unrolled: painted from the outside in (seen from the axis), contact faces on top
-    strip = unrolled(reference, X[quads], radius)
-    strip_order = np.argsort(-np.linalg.norm(reference(X[quads].mean(axis=1)), axis=1), kind="stable")
-    contact_strip = unrolled(reference, X[contact.surface.quads[touching[order]]], radius)
+    strip = unrolled(reference, X[valve_quads], radius)
+    strip_order = np.argsort(-np.linalg.norm(reference(X[valve_quads].mean(axis=1)), axis=1), kind="stable")
+    contact_strip = unrolled(reference, X[quads[touching[order]]], radius)
     with readable_style():
         fig = Figure(figsize=(8.0, 10.0), layout="constrained")
         top, bottom = fig.subplots(2, 1, height_ratios=[2.2, 1.0])
@@ -324,7 +329,7 @@ def _free_edges(faces: dict[str, np.ndarray], annulus: set[tuple[int, int]]) -> 
     return free
 
 
-def orifice_outline(setup: ClosureSetup, u: np.ndarray, t: float, path, surface: str = "mid",
+def orifice_outline(setup: ValveSetup, u: np.ndarray, t: float, path, surface: str = "mid",
                     credit: str = CREDIT) -> OrificeFigure:
     """The annulus polygon on its best-fit plane (Table 2's orifice) with the leaflets and their free edges."""
     points, faces, ring = _valve_surface(setup, u, surface)
@@ -353,7 +358,7 @@ def orifice_outline(setup: ClosureSetup, u: np.ndarray, t: float, path, surface:
     return OrificeFigure(Path(path), fig, polygon, area)
 
 
-def write_figures(setup: ClosureSetup, u: np.ndarray, t: float, out, stem: str = "mathur2022",
+def write_figures(setup: ValveSetup, u: np.ndarray, t: float, out, stem: str = "mathur2022",
                   credit: str = CREDIT) -> list[Path]:
     """The three figures of a state as ``<out>/<stem>_{atrial_stress,coaptation,orifice}.png`` (the stress coloured
     up to its 99th percentile).
