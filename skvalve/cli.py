@@ -194,7 +194,7 @@ def build_parser() -> argparse.ArgumentParser:
     rep.add_argument("--out", default="skvalve_out", help="folder for the figures (created; must be writable)")
     rep.add_argument("--full", action="store_true", help="converged meshes and complete sweeps (slow)")
     rep.add_argument("--state", default=None, metavar="FILE",
-                     help="mathur2022: measure a kept closure state (benchmarks/trivalve_closure.py's last_state.npz) "
+                     help="mathur2022: measure a kept closure state (the state.npz of skvalve valve close) "
                           "instead of running the closure")
     rep.add_argument("--strict", action="store_true",
                      help="exit 1 if a row is a regression or an unexplained disagreement with the paper")

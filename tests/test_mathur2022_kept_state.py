@@ -1,90 +1,160 @@
-"""``skvalve reproduce mathur2022 --state``: kept closure states are read with clear errors for bad files, rebuilt
-with the options they record, and measured (a state short of the end is marked incomplete)."""
-
-import json
-from dataclasses import asdict
+"""``skvalve reproduce mathur2022 --state``: kept states of ``skvalve valve close`` (format 2) are matched to their
+input by name and size, rebuilt with the options they record, measured beside the input's paper column, and refused
+with the file named when they are not readable or fit no input."""
 
 import numpy as np
 import pytest
 
-from skvalve.io.abaqus import read_model, trivalve_input
-from skvalve.papers.mathur2022.reproduce import KEPT_STATE_OPTIONS, read_kept_state, reproduce
-from skvalve.papers.table import InputError, Row, Stage, Status
-from skvalve.valve.closure import ClosureOptions, closure_setup
-from skvalve.valve.model import valve_model
+from skvalve.cli import main
+from skvalve.io.abaqus import trivalve_inputs
+from skvalve.papers.mathur2022.data import PRESSURE_HEALTHY_MMHG, TABLE2_AREAS, TABLE3_CENTRE_STRESS
+from skvalve.papers.mathur2022.reproduce import present_inputs, reproduce, state_input
+from skvalve.papers.table import InputError, Row, Stage, Status, Written
+from skvalve.valve.options import CloseOptions, ContactOptions
 from skvalve.valve.outputs import closure_measures
+from skvalve.valve.setup import valve_setup
+from skvalve.valve.state import KeptState, write_state
+
+INPUTS = trivalve_inputs()
+DISEASED = "Diseased_QuasiStatic.inp"
+needs_10 = pytest.mark.skipif("1.0-diseased" not in INPUTS, reason="Texas TriValve 1.0 input not found")
 
 
-def test_a_state_without_options_is_measured_with_the_converged_contact(tmp_path):
-    path = tmp_path / "kept.npz"
-    np.savez(path, t=1.5, u=np.zeros(6))
-    kept = read_kept_state(path)
-    assert kept.t == 1.5 and kept.options is None
-    model = type("Model", (), {"pressures": [], "end_time": 1.5})()
-    options = kept.closure_options(model)
-    assert {key: getattr(options, key) for key in KEPT_STATE_OPTIONS} == KEPT_STATE_OPTIONS
+def _state(path, n: int, name: str = DISEASED, phase: str = "done", options: CloseOptions | None = None,
+           terms: dict | None = None):
+    write_state(path, KeptState(1.5, np.zeros(n), name, options or CloseOptions(), phase, terms=terms or {}))
+    return path
 
 
-def test_recorded_options_come_back_equal(tmp_path):
-    recorded = ClosureOptions(contact_depth=0.3, contact_barrier=0.2, cable_stiffening=(0.1, 0.2))
-    path = tmp_path / "kept.npz"
-    np.savez(path, t=1.0, u=np.ones(3), options=json.dumps(asdict(recorded)))
-    assert read_kept_state(path).closure_options(None) == recorded
+def _items(**kwargs) -> tuple[list[Stage], dict[str, Row], list[Written]]:
+    items = list(reproduce(**kwargs))
+    return ([item for item in items if isinstance(item, Stage)],
+            {item.quantity: item for item in items if isinstance(item, Row)},
+            [item for item in items if isinstance(item, Written)])
 
 
-@pytest.mark.parametrize(("content", "message"), [
-    ({"t": 1.5}, "no u"),
-    ({"t": 1.5, "u": np.array([0.0, np.nan])}, "finite"),
-    ({"t": 1.5, "u": np.zeros((2, 3))}, "one-dimensional"),
-    ({"t": 1.5, "u": np.zeros(3), "options": "[1, 2]"}, "JSON object"),
-    ({"t": 1.5, "u": np.zeros(3), "options": "{not json"}, "not a readable"),
-])
-def test_bad_kept_states_are_refused_naming_the_file(tmp_path, content, message):
-    path = tmp_path / "bad.npz"
-    np.savez(path, **content)
-    with pytest.raises(InputError, match=message) as info:
-        read_kept_state(path)
-    assert str(path) in str(info.value)
+@pytest.fixture(scope="module")
+def diseased():
+    return valve_setup(INPUTS["1.0-diseased"]) if "1.0-diseased" in INPUTS else None
 
 
-def test_a_missing_or_foreign_file_is_named(tmp_path):
-    with pytest.raises(FileNotFoundError, match="last_state.npz"):
-        read_kept_state(tmp_path / "absent.npz")
-    text = tmp_path / "notes.npz"
-    text.write_text("not a zip")
-    with pytest.raises(InputError, match="notes.npz"):
-        read_kept_state(text)
-
-
-@pytest.mark.skipif(trivalve_input() is None, reason="Texas TriValve input not found (../shared/data)")
-def test_kept_states_of_the_valve_are_checked_and_measured(tmp_path):
-    wrong = tmp_path / "wrong.npz"
-    np.savez(wrong, t=1.5, u=np.zeros(12))
-    with pytest.raises(InputError, match="dofs"):
-        list(reproduce(state=wrong))
-    model = valve_model(read_model(trivalve_input()))
-    setup = closure_setup(options=ClosureOptions.for_relaxation(model, **KEPT_STATE_OPTIONS), model=model)
-    zero = tmp_path / "zero.npz"
-    np.savez(zero, t=0.0, u=np.zeros(setup.problem.space.n_dofs))
-    items = list(reproduce(state=zero))
-    stages = " ".join(item.text for item in items if isinstance(item, Stage))
-    assert "not converged" in stages and "step time 0" in stages and "input not recorded" in stages
-    rows = {row.quantity: row for row in items if isinstance(row, Row)}
+@needs_10
+def test_a_converged_state_gives_the_diseased_column_measured_at_its_displacement(diseased, tmp_path):
+    n = diseased.problem.space.n_dofs
+    state = _state(tmp_path / "state.npz", n, options=CloseOptions(contact=ContactOptions(dhat=0.05)))
+    stages, rows, written = _items(out=tmp_path / "out", state=state)
+    expected = closure_measures(diseased, np.zeros(n), 1.5)  # zero displacement: the open leaflets at the end load
+    assert len(rows) == 6
+    orifice = rows["Table 2 orifice area, diseased (mm²; closed valve)"]
+    assert orifice.paper == TABLE2_AREAS["orifice"].diseased
+    assert orifice.skvalve == pytest.approx(expected.orifice["mid"], rel=1e-12)
+    assert orifice.status is Status.AGREES  # the input holds the annulus: the open orifice is within 3 % of 870 mm²
     area = rows["Table 2 leaflet area, diseased (mm²)"]
-    opened = closure_measures(setup, np.zeros(setup.problem.space.n_dofs), 0.0).leaflet_area["mid"]
-    assert area.skvalve == pytest.approx(opened, rel=1e-12)  # zero displacement: the open leaflets
-    assert "areal stretch from the open configuration" in area.note and "1.00 here" in area.note
-    assert "kept state zero.npz" in area.note and area.status is Status.DIFFERS
-    assert rows["Table 2 coaptation area, diseased (mm²)"].skvalve == 0.0  # nothing touches when open
-    assert rows["Table 2 orifice area, diseased (mm²; closed valve)"].skvalve == pytest.approx(
-        closure_measures(setup, np.zeros(setup.problem.space.n_dofs), 0.0).orifice["mid"], rel=1e-12)
+    assert area.skvalve == pytest.approx(expected.leaflet_area["mid"], rel=1e-12)
+    assert "1.00 here" in area.note and area.status is Status.DIFFERS
+    coaptation = rows["Table 2 coaptation area, diseased (mm²)"]
+    assert coaptation.skvalve == 0.0 and coaptation.paper == TABLE2_AREAS["coaptation"].diseased
+    assert "dhat = 0.05 mm" in coaptation.note and "penalty" not in coaptation.note  # the state's own options
+    for leaflet in ("anterior", "posterior", "septal"):
+        row = rows[f"Table 3 centre max principal Cauchy stress, {leaflet}, diseased (kPa)"]
+        assert row.paper == TABLE3_CENTRE_STRESS[leaflet].diseased and row.skvalve == 0.0
+    assert not any("INCOMPLETE" in row.note for row in rows.values())
+    text = " ".join(stage.text for stage in stages)
+    assert "phase 'done'" in text and "1.0-diseased" in text and "CC BY-NC-SA 4.0" in text
+    assert "recomputed" in text  # the static residual of the state, not only the recorded one
+    names = sorted(item.path.name for item in written)
+    assert names == ["mathur2022_atrial_stress.png", "mathur2022_coaptation.png", "mathur2022_kept_state.pvd",
+                     "mathur2022_orifice.png"]
+    assert (tmp_path / "out" / "mathur2022_kept_state_0000.vtu").stat().st_size > 100_000
 
 
-@pytest.mark.skipif(trivalve_input() is None, reason="Texas TriValve input not found (../shared/data)")
-def test_a_state_of_another_input_is_refused_by_name(tmp_path):
-    """The annuloplasty valve shares the diseased valve's mesh, so only the recorded input name tells them apart."""
-    path = tmp_path / "annuloplasty.npz"
-    np.savez(path, t=1.5, u=np.zeros(3), input="Annuloplasty_QuasiStatic.inp")
-    assert read_kept_state(path).input == "Annuloplasty_QuasiStatic.inp"
-    with pytest.raises(InputError, match="computed from Annuloplasty_QuasiStatic.inp, not Diseased_QuasiStatic.inp"):
-        next(reproduce(state=path))
+@needs_10
+def test_a_state_short_of_the_end_is_marked_incomplete_in_every_row(diseased, tmp_path):
+    state = _state(tmp_path / "state.npz", diseased.problem.space.n_dofs, phase="hold")
+    _, rows, written = _items(state=state)
+    assert written == []  # no out: nothing written
+    assert rows and all("INCOMPLETE" in row.note and "phase 'hold'" in row.note for row in rows.values())
+
+
+@needs_10
+def test_the_recorded_terms_state_is_restored(diseased, tmp_path):
+    n = diseased.problem.space.n_dofs
+    k = diseased.problem.terms.index(diseased.contact)
+    terms = {f"{k}/stiffness": np.array(0.123), f"{k}/u": np.zeros(n), f"{k}/t": np.array(1.5)}
+    key, kept, setup = state_input(_state(tmp_path / "state.npz", n, terms=terms), present_inputs())
+    assert key == "1.0-diseased" and kept.t == 1.5
+    assert setup.contact.stiffness == 0.123 and diseased.contact.stiffness != 0.123
+
+
+@needs_10
+def test_the_annuloplasty_state_is_compared_with_its_own_column(diseased, tmp_path):
+    """The annuloplasty valve shares the diseased valve's mesh: the recorded name picks the column."""
+    if "1.0-annuloplasty" not in INPUTS:
+        pytest.skip("annuloplasty input not present")
+    state = _state(tmp_path / "state.npz", diseased.problem.space.n_dofs, name="Annuloplasty_QuasiStatic.inp")
+    _, rows, _ = _items(state=state)
+    orifice = rows["Table 2 orifice area, annuloplasty (mm²; closed valve)"]
+    assert orifice.paper == TABLE2_AREAS["orifice"].annuloplasty
+    assert orifice.status is Status.DIFFERS and "LINK MPCs" in orifice.note  # the ring has not pulled the annulus in
+    assert rows["Table 3 centre max principal Cauchy stress, septal, annuloplasty (kPa)"].paper == \
+        TABLE3_CENTRE_STRESS["septal"].annuloplasty
+
+
+@pytest.mark.parametrize(("key", "column", "label", "reason"), [
+    ("1.1-healthy", "healthy", "healthy, TTV 1.1", f"{PRESSURE_HEALTHY_MMHG} mmHg"),
+    ("1.1-diseased", "diseased", "diseased, TTV 1.1", "another donor valve"),
+])
+def test_a_state_of_a_ttv_1_1_input_is_beside_the_paper_column_with_the_donor_named(tmp_path, key, column, label,
+                                                                                    reason):
+    if key not in INPUTS:
+        pytest.skip(f"{key} input not present")
+    n = valve_setup(INPUTS[key]).problem.space.n_dofs
+    _, rows, _ = _items(state=_state(tmp_path / "state.npz", n, name=INPUTS[key].name))
+    area = rows[f"Table 2 leaflet area, {label} (mm²)"]
+    assert area.paper == getattr(TABLE2_AREAS["leaflet"], column)
+    assert all("another donor valve" in row.note and reason in row.note and row.expected_difference is not None
+               for row in rows.values())
+
+
+@needs_10
+def test_states_that_fit_no_input_are_refused_naming_the_file_and_the_sizes(diseased, tmp_path):
+    n = diseased.problem.space.n_dofs
+    wrong = _state(tmp_path / "wrong.npz", 12)
+    with pytest.raises(InputError, match=rf"wrong.npz: 12 displacement values fits none .*1.0-diseased: {n}"):
+        list(reproduce(state=wrong))
+    if "1.1-healthy" in INPUTS:  # the right size for the 1.0 valves, the name of the 1.1 healthy one
+        other = _state(tmp_path / "other.npz", n, name="Healthy_QuasiStatic.inp")
+        with pytest.raises(InputError, match=r"other.npz: .* fits none .*1.1-healthy"):
+            list(reproduce(state=other))
+    if "1.0-clipping" in INPUTS:
+        clip = _state(tmp_path / "clip.npz", n, name="Clipping_QuasiStatic.inp")
+        with pytest.raises(InputError, match="clip.npz: Clipping_QuasiStatic.inp is an input the valve model does not"):
+            list(reproduce(state=clip))
+
+
+def test_a_state_of_an_unknown_input_is_refused_naming_both(tmp_path):
+    state = _state(tmp_path / "mitral.npz", 6, name="Mitral_QuasiStatic.inp")
+    with pytest.raises(InputError, match=r"mitral.npz: computed from 'Mitral_QuasiStatic.inp', which is none of"):
+        list(reproduce(state=state))
+
+
+@pytest.mark.parametrize("damage", ["garbage", "truncated", "version 1", "missing"])
+def test_unreadable_states_are_refused_naming_the_file(tmp_path, damage):
+    path = tmp_path / "kept.npz"
+    if damage == "garbage":
+        path.write_bytes(b"not a zip archive at all")
+    elif damage == "truncated":
+        _state(path, 300)
+        path.write_bytes(path.read_bytes()[:200])
+    elif damage == "version 1":  # benchmarks/trivalve_closure.py before skvalve.valve.run: t and u only
+        np.savez(path, t=1.5, u=np.zeros(6))
+    with pytest.raises(InputError, match=str(path)):
+        list(reproduce(state=path))
+
+
+def test_the_command_line_exits_2_with_the_file_named(tmp_path, capsys):
+    path = tmp_path / "kept.npz"
+    path.write_bytes(b"garbage")
+    assert main(["reproduce", "mathur2022", "--out", str(tmp_path / "out"), "--state", str(path)]) == 2
+    last = capsys.readouterr().err.strip().splitlines()[-1]
+    assert last.startswith("skvalve: reproduce mathur2022: kept state") and str(path) in last

@@ -4,6 +4,8 @@
   the model's Abaqus input (CC BY-NC-SA 4.0, never copied into skvalve).
 * :mod:`.models` — those parameters as skvalve laws (kPa).
 * :mod:`.figures` — the closed valve seen from the atrium, the coaptation map and the orifice outline.
-* :mod:`.reproduce` — ``skvalve reproduce mathur2022``: Table 2 geometry of the open valve by default; with
-  ``--full`` the implicit closure (:mod:`skvalve.valve.closure`) and the Table 2–3 rows at end-systole.
+* :mod:`.columns` — which paper column of Tables 2–3 each Texas TriValve input (1.0 and 1.1) answers, and its rows.
+* :mod:`.reproduce` — ``skvalve reproduce mathur2022``: Table 2 geometry of the open valve by default; ``--state``
+  measures a kept state of :func:`skvalve.valve.run.close_valve`; ``--full`` closes every input present with it
+  and prints each one's Table 2–3 rows at end-systole.
 """

@@ -21,7 +21,7 @@ from typing import NamedTuple
 from ...io.abaqus import read_materials, trivalve_input
 
 __all__ = [
-    "CREDIT", "LEAFLETS", "ValveStates", "TABLE2_AREAS", "TABLE3_CENTRE_STRESS",
+    "CREDIT", "CREDIT_1_1", "LEAFLETS", "ValveStates", "TABLE2_AREAS", "TABLE3_CENTRE_STRESS",
     "PRESSURE_HEALTHY_MMHG", "PRESSURE_DISEASED_MMHG", "LEAFLET_THICKNESS", "CHORDAE_DIAMETER", "POISSON_RATIO",
     "BULK_MODULUS_KPA", "TIME_STEP_HEALTHY", "TIME_STEP_DISEASED", "CLIP_ARM_GAP", "ANNULOPLASTY_RING_SIZE",
     "ECHO_DISTANCES", "ECHO_ERROR_RANGE", "BIAXIAL_SAMPLE_SIZE", "BIAXIAL_FORCE_MN", "LeafletParameters",
@@ -29,6 +29,8 @@ __all__ = [
 ]
 
 CREDIT = "Mathur et al. 2022, Texas TriValve 1.0, CC BY-NC-SA 4.0"
+#: the Texas TriValve 1.1 inputs (a second donor valve, Soft Tissue Biomechanics Lab, the method of Mathur et al. 2022)
+CREDIT_1_1 = "Texas TriValve 1.1 (Soft Tissue Biomechanics Lab; method of Mathur et al. 2022), CC BY 4.0"
 LEAFLETS = ("anterior", "posterior", "septal")
 
 
