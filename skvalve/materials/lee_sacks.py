@@ -69,6 +69,10 @@ class LeeSacks(IsotropicInvariantLaw):
     def partials(self, I1bar: Array, J: Array, C: Array) -> Partials:
         c0, c1, c2 = self.c0, self.c1, self.c2
         x = I1bar - 3.0
+        with np.errstate(over="ignore"):  # beyond exp's range the energy is +inf: a line search rejects that state
+            return self._partials(c0, c1, c2, x, J)
+
+    def _partials(self, c0: float, c1: float, c2: float, x: Array, J: Array) -> Partials:
         if self.published_equation:
             E = np.exp(c2 * x)
             psi = 0.5 * c0 * x + 0.5 * c1 * (E - 1.0)
