@@ -107,12 +107,16 @@ def test_a_kept_state_is_resumed_with_its_own_options(setup, monkeypatch, tmp_pa
     assert any(text.startswith("1.0-diseased: resuming") for text in stages)
 
 
-def test_a_kept_state_of_another_input_in_the_folder_is_refused(setup, monkeypatch, tmp_path):
+@pytest.mark.parametrize(("name", "message"), [("Other.inp", "computed from 'Other.inp'.*choose another --out"),
+                                               ("Diseased_QuasiStatic.inp", "6 displacement values for the .* dofs")])
+def test_a_kept_state_of_another_input_in_the_folder_is_refused(setup, monkeypatch, tmp_path, name, message):
     folder = tmp_path / "1.0-diseased"
     folder.mkdir()
-    write_state(folder / "state.npz", KeptState(0.3, np.zeros(6), "Other.inp", CloseOptions()))
-    with pytest.raises(module.InputError, match="computed from 'Other.inp'.*choose another --out"):
-        _run(monkeypatch, StandIn(setup, np.zeros(6)), {"1.0-diseased": INPUTS["1.0-diseased"]}, tmp_path)
+    write_state(folder / "state.npz", KeptState(0.3, np.zeros(6), name, CloseOptions()))
+    stand_in = StandIn(setup, np.zeros(6))
+    with pytest.raises(module.InputError, match=message):
+        _run(monkeypatch, stand_in, {"1.0-diseased": INPUTS["1.0-diseased"]}, tmp_path)
+    assert stand_in.closed == []
 
 
 def test_a_closure_that_stops_is_measured_at_its_last_state_and_marked(setup, monkeypatch, tmp_path):

@@ -131,6 +131,7 @@ def _outputs(setup: ValveSetup, column: Column, u: np.ndarray, t: float, out: Pa
 
 
 def _measure_state(state: Path, out: Path | None) -> Iterator[Row | Stage | Written]:
+    yield Stage(f"reading kept state {state} and building its input's closure model")
     inputs = present_inputs()
     key, kept, setup = state_input(Path(state), inputs)
     column = COLUMNS[key]
@@ -153,12 +154,13 @@ def _close_one(key: str, path: Path, out: Path | None) -> Iterator[Row | Stage |
     column = COLUMNS[key]
     folder = None if out is None else Path(out) / key
     resume = folder is not None and (folder / STATE_FILE).is_file()
-    options = None
+    kept = None
     if resume:
         try:
-            options = read_state(folder / STATE_FILE, input_name=path.name).options
+            kept = read_state(folder / STATE_FILE, input_name=path.name)
         except StateError as err:
             raise InputError(f"{err} (remove it to close {key} from the open valve, or choose another --out)") from err
+    options = None if kept is None else kept.options
     try:
         setup = valve_setup(path, options)
     except UnsupportedInputError as err:
@@ -167,6 +169,9 @@ def _close_one(key: str, path: Path, out: Path | None) -> Iterator[Row | Stage |
         yield Stage(f"{key} ({path.name}): the paper's {column.state} column is not computed: the valve model does "
                     f"not represent {len(err.features)} keyword(s) of the input{what}; first: {err.features[0]}")
         return
+    if kept is not None and kept.u.size != setup.problem.space.n_dofs:
+        raise InputError(f"kept state {folder / STATE_FILE}: {kept.u.size} displacement values for the "
+                         f"{setup.problem.space.n_dofs} dofs of {key} (remove it, or choose another --out)")
     yield Stage(f"{key}: {'resuming' if resume else 'closing'} {path.name} ({column.credit})"
                 + ("" if folder is None else f" in {folder}"))
     last: dict[str, KeptState] = {}
