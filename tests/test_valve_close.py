@@ -60,3 +60,14 @@ def test_interrupted_run_resumes_to_the_uninterrupted_result(leaflet, tmp_path):
     np.testing.assert_allclose(resumed.u, whole.u, rtol=0.0, atol=1e-10 * np.abs(whole.u).max())
     lines = (tmp_path / "cut" / "closure.log").read_text().splitlines()
     assert len(lines) == whole.steps + whole.held_steps
+
+
+def test_an_end_before_the_pressure_runs_the_path_only(leaflet, tmp_path, caplog):
+    """Before the pressure (step time < 0.5) the hanging leaflet has no unique static state: the run keeps the path,
+    says so and reports itself not converged, instead of doubling a held pseudo-step that has nothing to do."""
+    options = CloseOptions(end=0.05)
+    with caplog.at_level("WARNING", logger="skvalve.valve"):
+        report = close_valve(leaflet[0], options, out=tmp_path, setup=_setup(leaflet, options), progress=False)
+    assert not report.converged and report.held_steps == 0 and report.t == 0.05
+    assert "no pressure" in caplog.text
+    assert read_state(tmp_path / "state.npz").phase == "hold"

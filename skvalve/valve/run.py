@@ -170,6 +170,13 @@ class _Run:
         s.iterations += len(history)
         return relative
 
+    def idle(self) -> bool:
+        """True when the kept state already meets a damped step's absolute tolerance (:meth:`step`'s ``atol``), so
+        that a damped held step would accept it without an iteration."""
+        residual, _ = self.problem.assemble(self.state.u, self.end, tangent=False)
+        free = self.problem.pattern.free
+        return float(np.linalg.norm(residual[free])) <= self.options.steps.rtol * self.setup.load_scale
+
     # ------------------------------------------------------------ phases
     def path(self, bar) -> None:
         opts, s = self.options.steps, self.state
@@ -202,14 +209,26 @@ class _Run:
         opts, steps, s = self.options.hold, self.options.steps, self.state
         if opts.max_steps == 0:  # the path only (e.g. a run that stops part-way along the load path)
             return
+        if not any(float(np.max(np.abs(load.at(self.end)))) > 0.0 for load in self.setup.model.pressures):
+            # before the pressure: leaflets hanging from chordae and annulus have no unique static state to hold
+            logger.warning("%s: no pressure at step time %.6g: the path only, no held load", s.input, self.end)
+            return
         while s.phase == "hold":
             if s.held_steps >= opts.max_steps:
                 raise ClosureFailed(f"{s.input}: held load not converged in {opts.max_steps} steps (relative "
                                     f"residual {s.relative_residual:.3e}; the kept state is the last one)")
             clock = time.perf_counter()
-            static = np.isfinite(s.relative_residual) and s.relative_residual <= opts.static_below
+            # the static problem once the static residual is small, or where a damped held step would find nothing to
+            # do at its tolerance (a held load with hardly any reaction: the relative residual stays large however
+            # long the pseudo-step grows)
+            idle = self.idle()
+            static = idle or (np.isfinite(s.relative_residual) and s.relative_residual <= opts.static_below)
             outcome = self.attempt(self.end, 0.0, opts.rtol, steps.max_iter) if static else None
             if outcome is None:
+                if idle:
+                    raise ClosureFailed(f"{s.input}: the static problem at step time {self.end:.6g} failed "
+                                        f"({self.last_error}) and a damped held step has nothing left to do at its "
+                                        "tolerance (the kept state is the last one)")
                 outcome = self.attempt(self.end, steps.damping / s.increment, steps.rtol, steps.max_iter)
                 if outcome is None:
                     s.increment *= 0.5
