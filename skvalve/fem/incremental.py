@@ -347,14 +347,16 @@ def _line_search(problem: Problem, u: np.ndarray, p: np.ndarray, cap: float, slo
             continue
         trial_gradient = trial_residual + inertia * (trial - predictor)
         trial_value = along(alpha, trial, trial_tangent.contributions)
+        with np.errstate(over="ignore"):  # a trial deep in an exponential law: +inf, rejected below
+            trial_norm = float(np.linalg.norm(trial_gradient[free]))
         resolved = abs(alpha * slope) > ENERGY_RESOLUTION * abs(value)
         if along.base_work is not None:  # phi's trapezoid is O(alpha^3): near a solution |grad| decides as well
             ok = (trial_value <= value + opts.armijo * alpha * slope
-                  or np.linalg.norm(trial_gradient[free]) <= (1.0 - opts.armijo * alpha) * norm)
+                  or trial_norm <= (1.0 - opts.armijo * alpha) * norm)
         elif resolved:
             ok = trial_value <= value + opts.armijo * alpha * slope
         else:  # the decrease is below the energy's rounding: the gradient's norm decides
-            ok = (np.linalg.norm(trial_gradient[free]) < norm
+            ok = (trial_norm < norm
                   and trial_value <= value + ENERGY_RESOLUTION * abs(value))
         if ok and np.isfinite(trial_value):
             accepted = (trial, trial_residual, trial_tangent, trial_gradient, trial_value)
