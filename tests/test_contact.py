@@ -192,6 +192,38 @@ def test_open_surfaces_have_no_pairs_and_own_neighbourhood_is_excluded():
     assert sheet.active_pairs(u).size == 0
 
 
+def test_contact_pairs_closer_than_exclude_within_in_the_reference_are_never_active():
+    """The two faces at z = 1 coincide in the reference: pressed 0.1 into each other, every node pairs (9 per face,
+    two passes). A node over a triangle lies at most its circumradius (0.37 here) from the centroid in the
+    reference: excluded within 0.4, none pairs (what keeps rim nodes off their own leaflet's inner face); within 0.1
+    (below the smallest vertex-centroid distance, 0.24), all still do."""
+    problem, contact = block_contact_problem(2, 2, 50.0)
+    X = problem.space.dof_coordinates
+    u = np.zeros(problem.space.n_dofs)
+    u[2::3][X[2] > 1.0 + 1e-9] -= 0.1
+    top_face = np.flatnonzero(np.isclose(X[2], 1.0))
+    top_face = top_face[top_face >= 27]  # the top block's copy of the face
+    u[3 * top_face + 2] -= 0.1
+    assert contact.active_pairs(u).size == 18
+    contact.exclude_within = 0.1
+    assert contact.active_pairs(u).size == 18
+    contact.exclude_within = 0.4
+    assert contact.active_pairs(u).size == 0
+    with pytest.raises(ValueError, match="exclude_within"):
+        SurfaceContact(problem.space, contact.surface, 1.0, exclude_within=-1.0)
+
+
+def test_search_depth_and_rounding_default_to_the_mean_face_edge():
+    """Without ``max_penetration`` the search depth is the mean edge of the surface's faces, without ``smoothing`` the
+    rounding 1 % of it (0.5 and 0.005 on the 2 x 2 faces of unit blocks); given, they are taken as they are."""
+    problem, contact = block_contact_problem(2, 2, 10.0)
+    default = SurfaceContact(problem.space, contact.surface, 10.0)
+    assert default.max_penetration == pytest.approx(0.5, rel=1e-12)
+    assert default.smoothing == pytest.approx(0.005, rel=1e-12)
+    given = SurfaceContact(problem.space, contact.surface, 10.0, max_penetration=0.2, smoothing=0.05)
+    assert (given.max_penetration, given.smoothing) == (0.2, 0.05)
+
+
 def test_oriented_quads_point_away_from_inside():
     X = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=float)
     quads = oriented_quads(X, np.array([[0, 2, 1, 3]]), inside=np.array([[0.5, 0.5, -1.0]]))

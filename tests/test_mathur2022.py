@@ -1,9 +1,11 @@
-"""mathur2022 data: the TriValve material parameters as read from an Abaqus deck, bad decks named clearly."""
+"""mathur2022 data: the TriValve material parameters as read from an Abaqus deck, bad decks named clearly; the
+reproduction without the shipped input exits with a message."""
 
 from __future__ import annotations
 
 import pytest
 
+from skvalve.papers.mathur2022 import reproduce as reproduce_module
 from skvalve.papers.mathur2022.data import LEAFLETS, read_trivalve_materials
 from skvalve.papers.mathur2022.models import chordae_law, leaflet_law
 
@@ -43,3 +45,12 @@ def test_bad_decks_are_named(tmp_path, monkeypatch):
         read_trivalve_materials(path)
     with pytest.raises(FileNotFoundError, match="SKVALVE_TRIVALVE"):
         read_trivalve_materials(tmp_path / "missing.inp")
+
+
+def test_reproduce_without_the_shipped_input_exits_with_a_message(monkeypatch, capsys):
+    module = reproduce_module
+    monkeypatch.setattr(module, "trivalve_input", lambda: None)
+    with pytest.raises(SystemExit) as exit_info:
+        next(module.reproduce(None))
+    assert exit_info.value.code == module.EXIT_NO_INPUT == 2
+    assert "SKVALVE_TRIVALVE" in capsys.readouterr().err

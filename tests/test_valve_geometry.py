@@ -17,7 +17,6 @@ from scipy.spatial.transform import Rotation
 
 from skvalve.io.abaqus import read_model, trivalve_inputs
 from skvalve.papers.mathur2022.data import LEAFLET_THICKNESS, TABLE2_AREAS
-from skvalve.valve.closure import ClosureSetup, closure_setup
 from skvalve.valve.geometry import (
     annulus_nodes,
     boundary_loops,
@@ -32,6 +31,7 @@ from skvalve.valve.geometry import (
 )
 from skvalve.valve.model import valve_model
 from skvalve.valve.outputs import abaqus_positions, closure_measures
+from skvalve.valve.setup import valve_setup
 
 ROTATION = Rotation.from_rotvec([0.3, -1.1, 0.7]).as_matrix()
 SHIFT = np.array([4.0, -2.0, 9.0])
@@ -307,7 +307,7 @@ GAUSS_POINTS, GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(3)
 @pytest.fixture(scope="module", params=SHELL_INPUTS or [pytest.param(None, marks=pytest.mark.skip(
     reason="Texas TriValve 1.1 inputs not present"))])
 def shell_valve(request):
-    """(closure setup, independently read input, its leaflet shell quads by leaflet) of one 1.1 input."""
+    """(valve_setup of one 1.1 input, the input read independently, its leaflet shell quads by leaflet)."""
     logging.getLogger("skvalve.io.abaqus.reader").setLevel(logging.ERROR)
     path = INPUTS[request.param]
     model = read_model(path)
@@ -318,7 +318,7 @@ def shell_valve(request):
         (elements,) = [s.indices for key, s in model.element_sets.items()
                        if key.endswith(f".{leaflet.upper()}_LEAFLET_ELEMENTS")]
         quads[leaflet] = np.array([rows[int(e)] for e in elements])
-    return closure_setup(path), model, quads
+    return valve_setup(path), model, quads
 
 
 def _bilinear_tangent_cross(corners):
@@ -427,8 +427,8 @@ def test_shell_nodes_follow_the_middle_of_their_extruded_fibre(tmp_path, layers)
     logging.getLogger("skvalve.io.abaqus.reader").setLevel(logging.ERROR)
     abaqus = read_model(path)
     model = valve_model(abaqus, layers=layers)
-    problem = model.problem()
-    setup = ClosureSetup(abaqus, model, problem, None, None, np.zeros(model.mesh.p.shape[1], dtype=int))
+    setup = valve_setup(abaqus, model=model)
+    problem = setup.problem
     X = model.mesh.p.T
     u = np.zeros(problem.space.n_dofs)
     np.testing.assert_allclose(abaqus_positions(setup, u), abaqus.nodes, rtol=0, atol=1e-13 * radius)

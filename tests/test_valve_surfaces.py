@@ -209,3 +209,27 @@ def test_shipped_brick_valve_contact_surface():
     found = {tuple(sorted(model.vertex_source[q].tolist())) for q in surface.quads.tolist()}
     assert found == expected and surface.quads.shape[0] == len(expected)
     _check_outward_and_on_the_boundary(surface, model)
+
+
+def test_the_pressure_loaded_skins_join_the_brick_contact_surface():
+    """1.0 diseased: the inner skins and rim tips together with the skin the input loads with pressure
+    (``Leaflet_Surfaces_Outer``: the penalty reference of ``benchmarks/contact_ipc.py``) are the union of both
+    surfaces, one face per element listed; with a 0.2 mm search depth the two skins of a leaflet (0.39 mm apart) never
+    pair in the open valve."""
+    abaqus, model = _read("1.0-diseased")
+    assert {load.surface.upper() for load in model.pressures} == {"LEAFLET_SURFACES_OUTER"}
+    loaded = tuple(dict.fromkeys(load.surface for load in model.pressures))
+    both = contact_surface(abaqus, model, CONTACT_SURFACES_1_0 + loaded)
+    inner = contact_surface(abaqus, model, CONTACT_SURFACES_1_0)
+    outer = contact_surface(abaqus, model, ["Leaflet_Surfaces_Outer"])
+
+    def keys(quads):
+        return {tuple(sorted(quad)) for quad in quads.tolist()}
+
+    assert keys(both.quads) == keys(inner.quads) | keys(outer.quads) and len(keys(both.quads)) == both.quads.shape[0]
+    listed = sum(len(group.elements) for group in abaqus.surface("Leaflet_Surfaces_Outer").faces)
+    assert len(keys(outer.quads)) == listed > 0
+    _check_outward_and_on_the_boundary(both, model)
+    space = Space(model.mesh)
+    contact = SurfaceContact(space, both, 1.0, max_penetration=0.2)
+    assert contact.active_pairs(np.zeros(space.n_dofs)).size == 0
