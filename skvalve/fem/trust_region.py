@@ -140,9 +140,9 @@ class TrustRegionOptions:
     stall_fraction, stall_window : float, int
         With ``stall_fraction`` > 0 the relaxation returns unconverged, with ``stalled`` set, once the energy drop
         averaged over the last ``stall_window`` accepted steps is below ``stall_fraction`` of its average over all of
-        them (scale-free: the same test for any valve or load). It ends a stage of a staged relaxation
-        (:func:`~skvalve.valve.relaxation.relax_closure`), e.g. projected steps that carry a structure a long way down
-        its energy and no longer do once it is there.
+        them (scale-free: the same test for any valve or load). It ends a stage of a staged relaxation (trust-region
+        runs one after the other, each from the state the one before ended at), e.g. projected steps that carry a
+        structure a long way down its energy and no longer do once it is there.
     solver : str or None
         Sparse backend (:func:`skvalve.fem.linsolve.solver_name`); PARDISO reports the inertia, SuperLU does not
         (then :math:`\alpha` rises only when a step is not a descent direction of the model).

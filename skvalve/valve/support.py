@@ -41,7 +41,7 @@ Missing in skvalve, with an estimate of the work (tests included):
 * **Multi-step history**: one load path through the three steps (total time 0-2.5) with amplitudes in
   step time, conditions and loads carried over (``OP=MOD``: a carried condition keeps its end-of-step
   value) or replaced (``OP=NEW``), and contact definitions per step; today :func:`valve_model` builds one
-  step and the closure driver hard-codes the two-stage schedule. One to two days.
+  step and :func:`~skvalve.valve.run.close_valve` follows that step's amplitudes. One to two days.
 * Re-opening in step 2 under zero pressure is an unloading path for the quasi-static solver; the damping
   used for closing helps but the open state is then only approximately the step-1 reference.
 
