@@ -32,7 +32,7 @@
 # | chordae law (3-term Ogden, uniaxial) | Eq. 2 | `skvalve.materials.uniaxial.OgdenUniaxial` |
 # | parameters as shipped in the input | Tables S1–S2 (supplement) | `skvalve.papers.mathur2022.data` |
 # | the valve: hexes, cables, conditions, pressure | Sects. 2.5–2.9 | `skvalve.valve.model.valve_model` |
-# | implicit quasi-static closure | Sect. 2.8 (explicit there) | `skvalve.fem` terms, `skvalve.fem.newton.solve` |
+# | implicit quasi-static closure | Sect. 2.8 (explicit there) | `fem.newton.solve` (§3), `valve.run.close_valve` (§4) |
 # | Tables 2–3 | Sect. 3.3 | `skvalve.valve.outputs`, `skvalve.papers.mathur2022.data` |
 #
 # Every number the text quotes is computed in a cell and checked there against a closed form or the paper. Units are
@@ -346,8 +346,8 @@ if HAVE_DATA:
 # %% [markdown]
 # ## 3. A closure within the chapter's budget: one leaflet, its chordae, partial load
 #
-# The full valve (18 920 hexes, 75 000 unknowns, leaflet contact) is five times the reduced problem below and needs
-# far more Newton iterations: `skvalve reproduce mathur2022 --full` and `benchmarks/trivalve_closure.py` run it
+# The full valve (18 920 hexes, 75 000 unknowns, contact between the leaflets) is five times the reduced problem below
+# and needs far more Newton iterations: `skvalve valve close` and `skvalve reproduce mathur2022 --full` close it
 # (Sect. 4).
 # This notebook must run in a few minutes on two cores, so it solves a **reduced problem**: the posterior leaflet
 # (the smallest) with all the cables that hang from it — through the chordae-only branch points down to the
@@ -366,7 +366,8 @@ if HAVE_DATA:
 #   $c(t) = c_0(1-t/1.25)^2$, which carries the unloaded, floppy leaflet through the first steps and vanishes before
 #   the end of the load path.
 #
-# Leaflet contact (`skvalve.fem.contact.SurfaceContact`) is left out: a single leaflet has nothing to coapt with.
+# Leaflet contact (the whole valve's `skvalve.fem.contact.IPCContact`, Sect. 4) is left out: a single leaflet has
+# nothing to coapt with.
 
 # %%
 if HAVE_DATA:
@@ -427,10 +428,12 @@ if HAVE_DATA:
 # papillary stage is the hard part. The chords, over 10⁴ times stiffer than the leaflet ($E$ = 80–130 MPa against $3c_0$
 # = 3 kPa), tighten one by one as the tips descend and tug single free-edge nodes of a leaflet that has no load yet to
 # hold its shape: with the chords at full stiffness Newton converges only linearly (line-search steps of ½) and longer
-# steps invert the hexes next to the insertions before the leaflet follows. The full closure (`skvalve.valve.closure`)
-# therefore uses a **continuation**: the chords start with their taut law scaled by $s_0 = 10^{-3}$ (still over 25 times
+# steps invert the hexes next to the insertions before the leaflet follows. Load-stepped Newton therefore needs a
+# **continuation** here: the chords start with their taut law scaled by $s_0 = 10^{-3}$ (still over 25 times
 # stiffer than the leaflet) and regain it geometrically, $s(t) = s_0^{\,1 - S(\xi)}$ with the smooth step $S$ over
-# $0.4 \le t \le 0.6$ (`GeometricRamp`), before the pressure rises. The chapter does the same and stops at **step time
+# $0.4 \le t \le 0.6$ (`GeometricRamp`), before the pressure rises. (The whole-valve closure of Sect. 4 needs none:
+# its chords carry their full law from the start, and the viscous pseudo-mass of its incremental-potential steps holds
+# the nodes that nothing else holds yet.) The chapter uses it and stops at **step time
 # 0.25**: the papillary tips 7 mm down (half their way), no pressure yet, in five nominal steps with an absolute force
 # tolerance of $10^{-4}$ N (the final pressure load on this leaflet is about 1.6 N). This is a state of the
 # continuation, not yet of the input's model (the chords are still at $10^{-3}$ of their stiffness). If the solver stops
@@ -599,43 +602,25 @@ if HAVE_DATA:
 # reach. Beyond the partial load, a single leaflet differs from the valve in what
 # carries the pressure at end-systole: without its neighbours it cannot coapt, so under full pressure only its chordae
 # would stop it (prolapse), whereas in the valve the contact with the anterior and septal leaflets bears much of the
-# load; and the implicit quasi-static solution (no mass scaling, penalty contact, damping switched off at
-# $t = 1.25$) is not the explicit-dynamic one of the paper.
+# load; and the implicit quasi-static solution (no mass scaling, barrier contact, the end state a static equilibrium)
+# is not the explicit-dynamic one of the paper.
 #
 # ## 4. The full runs
 #
-# * `skvalve reproduce mathur2022` compares the orifice and leaflet areas of the open configuration with Table 2
-#   (minutes); `skvalve reproduce mathur2022 --full --out out/` runs the implicit closure of the whole diseased valve
-#   with leaflet contact (`skvalve.valve.relaxation.relax_closure`: all three leaflets, 690 cables at their full law,
-#   those that are one input truss also in compression, as the input's trusses are,
-#   `SurfaceContact` on the input's contact surfaces) by *pseudo-transient continuation* (`skvalve.fem.ptc`): one
-#   damped, linearised implicit-Euler step per pseudo-time step, no equilibrium asked for on the way, trust regions
-#   on nodal motion and on the tensile stretch of every hex edge and cable (the linear step from the toe of an
-#   exponential law into its steep part is what overshoots). At the held load the valve is still closing, through
-#   directions of negative curvature, and damped steps only creep along them; there an *energy trust region*
-#   (`skvalve.fem.trust_region`) takes over: each step's energy change is the work of the residual along it
-#   (Simpson's rule), the step matrix is the symmetric tangent plus an inertia-corrected shift (projecting every
-#   element block onto its positive semidefinite part is an option, off for the valve: it drops the curvature of the
-#   valve's softest modes, `skvalve.fem.soft_modes`), and a step is kept when the energy falls by a fair
-#   share of what its quadratic model predicts. The follower pressure on leaflets with free edges is not
-#   conservative, so close to equilibrium that energy is only approximate; below a relative residual of 1e-4 each step
-#   first tries Newton's step with the full tangent and keeps it when the residual halves. Every step, damped or not,
-#   is cut where it would carry a contact node deeper than ¾ of the search depth through a leaflet
-#   (`skvalve.fem.contact.clearance`: the gap of each near node-triangle pair followed along the step; sliding is
-#   free): past that depth the penalty fades out and would let the node through. A node that the forces press
-#   to that floor stops every step there; `SurfaceContact(barrier=...)` (`skvalve.fem.contact.laws`) adds a log
-#   barrier that grows without bound towards the floor and so meets such a force first (off by default: on the
-#   valve, pairs already deep when the contact switches on fade out through its height). It prints all Table 2–3
-#   rows of the diseased column, with a VTU/PVD
-#   series for ParaView. The load-stepped Newton closure of this section
-#   (`run_closure`, soft chords, converged damped steps) stalls in the tethering stage of the whole valve.
-# * `benchmarks/trivalve_closure.py --out DIR` runs the same closure and reports wall time, pseudo-steps, rejected
-#   steps, contact pairs and peak memory (`--resume` restarts from the last state kept on disk; `--resume --report`
-#   measures and draws it).
-# * A chain of such runs, resumed with the contact search depth at half the leaflet, the depth barrier, the loaded
-#   skins in contact and the nodes parked in the penalty's fade-out lifted out of it
-#   (`skvalve.valve.contact_lift.lift_parked_nodes`, `--lift-parked`), brought the held diseased valve to the residual
-#   asked for; the documentation's mathur2022 page lists the runs and their rows beside the paper's, and
-#   `skvalve reproduce mathur2022 --state DIR/last_state.npz` prints the Table 2–3 rows of any kept state.
+# * `skvalve valve close FILE --out DIR` closes a whole valve input with the defaults of `skvalve.valve.options`
+#   (`skvalve.valve.run.close_valve`). Contact is the IPC barrier (`skvalve.fem.contact.IPCContact`) on the leaflets'
+#   whole hex boundary, on from the start. The load path follows the input's amplitudes (papillary motion, then the
+#   pressure) in incremental-potential steps (`skvalve.fem.incremental`) of adaptive length, each a minimisation by
+#   shifted Newton with a collision-free line search: every trial is cut to the share of the step that continuous
+#   collision detection finds free, so no iterate passes through a leaflet and no state needs repair. A viscous
+#   pseudo-mass holds the nodes that nothing else holds yet; at the held load it fades, and the static problem is
+#   solved to a relative residual of 1e-6. The state is kept after every accepted step (`DIR/state.npz`, with
+#   `closure.log`; `closure.pvd` at the end), and `--resume` continues an interrupted run from it.
+# * `skvalve reproduce mathur2022 --full --out out/` closes every Texas TriValve input present that way, each in
+#   `out/<key>` and resumed from the state kept there, and prints the Table 2–3 rows of each column with figures and
+#   a VTU/PVD series (the clip repair's column is reported as not computed: its rigid clip arms are not modelled);
+#   `skvalve reproduce mathur2022 --state FILE` prints the rows of a kept state without solving.
+# * `benchmarks/trivalve_closure.py` times one `close_valve` call on the 1.0 diseased valve and splits its wall time
+#   (assembly, contact, continuous collision detection, factorisation).
 #
-# Both need the authors' input files (`$SKVALVE_TRIVALVE`) and take far longer than this notebook on two cores.
+# All need the authors' input files (`$SKVALVE_TRIVALVE`) and take far longer than this notebook on two cores.
