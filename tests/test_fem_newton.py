@@ -3,13 +3,17 @@
 import meshio
 import numpy as np
 import pytest
+import skfem
 from scipy.optimize import brentq
 
 from skvalve.analytic import homogeneous
-from skvalve.fem import ConvergenceError, NonPositiveJacobianError, Solid
+from skvalve.fem import ConvergenceError, NonPositiveJacobianError, Solid, newton
 from skvalve.fem.meshes import box, rectangle
+from skvalve.fem.problem import Problem
+from skvalve.fem.truss import Truss
 from skvalve.io.timeseries import TimeSeriesWriter
 from skvalve.materials import BimodularNeoHookean, IncompressibleNeoHookean, NeoHookean
+from skvalve.materials.uniaxial import LinearUniaxial, TensionOnly
 
 MATERIAL = NeoHookean.from_shear_poisson(1.0, 0.3)
 
@@ -208,3 +212,51 @@ def test_reaction_moment_3d_balances():
     assert np.allclose(m_left + m_right, 0.0, atol=1e-8 * np.abs(m_right).max())
     assert np.allclose(result.reaction("left") + result.reaction("right"), 0.0, atol=1e-9)
     assert m_right[0] > 0 and abs(m_right[0]) > 10 * np.abs(m_right[1:]).max()
+
+
+def _slack_chord_pulled_taut():
+    """Two unit blocks 2 apart, tied face centre to face centre by a tension-only chord of rest length 2.1; the
+    second block is moved 0.4 away in two load steps, so the chord turns taut within the first."""
+    first = skfem.MeshHex().refined(1)
+    second = skfem.MeshHex().refined(1).translated([3.0, 0.0, 0.0])
+    both = skfem.MeshHex(np.hstack([first.p, second.p]), np.hstack([first.t, second.t + first.p.shape[1]]))
+    solid = Solid(both, NeoHookean(1.0, 5.0))
+    X = solid.space.dof_coordinates
+    face = np.flatnonzero(np.isclose(X[0], 1.0) & np.isclose(X[1], 0.5) & np.isclose(X[2], 0.5))[0]
+    anchor = np.flatnonzero(np.isclose(X[0], 3.0) & np.isclose(X[1], 0.5) & np.isclose(X[2], 0.5))[0]
+    law = TensionOnly(LinearUniaxial(10.0), slack_fraction=1e-4)
+    chord = solid.add_term(Truss(solid.space, [[face, anchor]], 0.2, law, rest_length=[2.1]))
+    solid.add_dirichlet(lambda X: X[0] < 1e-9, 0.0)
+    moved = np.flatnonzero(X[0] > 2.5)
+    solid.add_dirichlet(nodes=moved, value=0.4, components=[0]).add_dirichlet(nodes=moved, value=0.0, components=[1, 2])
+    return solid, chord
+
+
+def test_the_true_residual_is_assembled_only_where_the_first_full_step_fails(monkeypatch):
+    """The line search's limit after a prescribed move is the true residual with the new prescribed values; it is
+    assembled only where the full first step does not beat the linearised one (the step where the chord turns taut),
+    and the last assembled state is always the accepted one (terms with state commit it)."""
+    solid, chord = _slack_chord_pulled_taut()
+    true_calls, last = [], {}
+    original_true, original_assemble = newton._true_residual, Problem.assemble
+
+    def true_residual(*args, **kwargs):
+        true_calls.append(args[1].copy())
+        return original_true(*args, **kwargs)
+
+    def assemble(self, u, *args, **kwargs):
+        last["u"] = np.array(u, copy=True)
+        return original_assemble(self, u, *args, **kwargs)
+
+    monkeypatch.setattr(newton, "_true_residual", true_residual)
+    monkeypatch.setattr(Problem, "assemble", assemble)
+    mismatches = []
+    result = solid.solve(steps=2, progress=False, rtol=1e-11,
+                         callbacks=[lambda event: mismatches.append(np.max(np.abs(last["u"] - event.u)))])
+    assert len(true_calls) == 1  # step 1 only: the taut chord's force is not in the linearised residual
+    assert [record["alpha"] for record in result.log if record["iteration"] == 1] == [1.0, 1.0]
+    assert max(mismatches[1:]) == 0.0  # steps 1 and 2 end on their accepted, last assembled state
+    u = result.u()
+    tension = chord.response(u).axial_force[0]
+    assert tension > 0.0
+    assert result.reaction(lambda X: X[0] < 1e-9)[0] == pytest.approx(-tension, rel=1e-8)  # block 1 in balance
