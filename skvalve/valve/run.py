@@ -170,12 +170,14 @@ class _Run:
         s.iterations += len(history)
         return relative
 
-    def idle(self) -> bool:
-        """True when the kept state already meets a damped step's absolute tolerance (:meth:`step`'s ``atol``), so
-        that a damped held step would accept it without an iteration."""
-        residual, _ = self.problem.assemble(self.state.u, self.end, tangent=False)
-        free = self.problem.pattern.free
-        return float(np.linalg.norm(residual[free])) <= self.options.steps.rtol * self.setup.load_scale
+    def idle(self, rtol: float) -> bool:
+        """True when the kept state already meets a damped step's convergence test at ``rtol`` (:meth:`step`: below
+        ``rtol`` times the larger of the reactions' and loads' scale and the end load's), so that a damped held step
+        would accept it without an iteration."""
+        problem = self.problem
+        residual, _ = problem.assemble(self.state.u, self.end, tangent=False)
+        scale = max(reference_force(problem, residual, problem.pattern.fixed), self.setup.load_scale)
+        return float(np.linalg.norm(residual[problem.pattern.free])) <= rtol * scale
 
     # ------------------------------------------------------------ phases
     def path(self, bar) -> None:
@@ -218,10 +220,15 @@ class _Run:
                 raise ClosureFailed(f"{s.input}: held load not converged in {opts.max_steps} steps (relative "
                                     f"residual {s.relative_residual:.3e}; the kept state is the last one)")
             clock = time.perf_counter()
+            # a damped held step converges to a tenth of the static residual it starts from (a forcing term: at the
+            # path's looser tolerance a state the path left at, say, 0.9 of it would be accepted as it is, and the
+            # held steps would not move), and not below the hold's aim
+            forcing = (min(steps.rtol, max(opts.rtol, 0.1 * s.relative_residual))
+                       if np.isfinite(s.relative_residual) else steps.rtol)
             # the static problem once the static residual is small, or where a damped held step would find nothing to
             # do at its tolerance (a held load with hardly any reaction: the relative residual stays large however
             # long the pseudo-step grows)
-            idle = self.idle()
+            idle = self.idle(forcing)
             static = idle or (np.isfinite(s.relative_residual) and s.relative_residual <= opts.static_below)
             outcome = self.attempt(self.end, 0.0, opts.rtol, steps.max_iter) if static else None
             if outcome is None:
@@ -229,7 +236,7 @@ class _Run:
                     raise ClosureFailed(f"{s.input}: the static problem at step time {self.end:.6g} failed "
                                         f"({self.last_error}) and a damped held step has nothing left to do at its "
                                         "tolerance (the kept state is the last one)")
-                outcome = self.attempt(self.end, steps.damping / s.increment, steps.rtol, steps.max_iter)
+                outcome = self.attempt(self.end, steps.damping / s.increment, forcing, steps.max_iter)
                 if outcome is None:
                     s.increment *= 0.5
                     if s.increment < steps.smallest:

@@ -1,0 +1,58 @@
+"""The held phase of :func:`skvalve.valve.run.close_valve` on a stand-in setup (a block under a follower pressure with
+IPC contact on its boundary): damped held steps alone, with the static solve refused, must reach the static
+equilibrium. Each converges to a tenth of the static residual it starts from (a forcing term); at the path's own
+tolerance a state the path left just inside it would be accepted as it is, and the held steps would not move (the
+1.0 diseased valve's first held steps did that: 0 iterations each, the residual unchanged)."""
+
+from types import SimpleNamespace
+
+import numpy as np
+
+from skvalve.fem import Solid
+from skvalve.fem.contact import IPCContact
+from skvalve.fem.errors import SolverError
+from skvalve.fem.meshes import box
+from skvalve.fem.newton import solve
+from skvalve.materials import NeoHookean
+from skvalve.valve import run as run_module
+from skvalve.valve.options import CloseOptions, HoldOptions, StepOptions
+from skvalve.valve.setup import ValveSetup
+
+PRESSURE = 0.05
+
+
+def _block() -> ValveSetup:
+    """A unit block fixed on x = 0 under a follower pressure on x = 1 (ramped over step time 0-1), with the
+    ValveSetup fields the run reads."""
+    mesh = box((2, 2, 2))
+    solid = Solid(mesh, NeoHookean.from_shear_poisson(1.0, 0.3))
+    solid.add_dirichlet("left", 0.0)
+    solid.add_pressure("right", PRESSURE)
+    contact = solid.add_term(IPCContact(solid.space, dhat=1e-3, stiffness=1.0))
+    model = SimpleNamespace(mesh=mesh, end_time=1.0, pressures=[SimpleNamespace(at=lambda t: np.array([PRESSURE * t]))])
+    n = mesh.p.shape[1]
+    volumes = np.full(3 * n, 1.0 / n)
+    return ValveSetup(None, model, solid, contact, np.zeros(n, dtype=np.int64), volumes, "block", PRESSURE)
+
+
+def test_damped_held_steps_alone_reach_the_static_equilibrium(monkeypatch):
+    attempt = run_module._Run.attempt
+
+    def no_static(self, t_new, inertia_scale, rtol, max_iter):
+        if inertia_scale == 0.0:
+            self.last_error = SolverError("static solve refused by the test")
+            return None
+        return attempt(self, t_new, inertia_scale, rtol, max_iter)
+
+    monkeypatch.setattr(run_module._Run, "attempt", no_static)
+    options = CloseOptions(steps=StepOptions(first=0.25, largest=0.25, damping=1.0), hold=HoldOptions(max_steps=60))
+    report = run_module.close_valve(None, options, setup=_block(), progress=False)
+    assert report.converged and report.relative_residual <= 1e-6
+    held = [record for record in report.records if record.phase == "hold"]
+    assert held and all(record.iterations > 0 for record in held)  # every held step moved
+    residuals = [record.relative_residual for record in held]
+    assert all(b < a for a, b in zip(residuals, residuals[1:], strict=False))
+    # the same block by load-stepped Newton: the held state is its equilibrium
+    reference = _block().problem
+    newton = solve(reference, steps=4, rtol=1e-10, progress=False)
+    np.testing.assert_allclose(report.u, newton.u(), atol=1e-5 * np.abs(newton.u()).max())
