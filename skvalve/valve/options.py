@@ -126,7 +126,8 @@ class StepOptions:
 
 @dataclass(frozen=True)
 class HoldOptions:
-    """The held load at the end: pseudo-steps whose pseudo-mass fades (the step doubles), then the static problem.
+    """The held load at the end: pseudo-steps whose pseudo-mass fades (the step doubles), each converged to a tenth
+    of the static residual it starts from (not below ``rtol``), then the static problem.
 
     rtol
         the undamped, static residual asked for (relative to reactions and loads).

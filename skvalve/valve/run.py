@@ -10,9 +10,10 @@ repair afterwards.
 Path (:class:`~skvalve.valve.options.StepOptions`): incremental-potential steps
 (:func:`~skvalve.fem.incremental.minimise_step`) with a viscous pseudo-mass :math:`cV_i/\Delta t`, whose length
 grows after easy steps and halves after failed ones. Held load (:class:`~skvalve.valve.options.HoldOptions`): the
-same steps at the end time with the pseudo-step doubling (the pseudo-mass fading), and the static problem once the
-static residual is small, solved to ``rtol`` (1e-6) of the undamped problem. The merit of the line search is the
-residual norm: the follower pressure on the leaflets' open surface and the F-bar hexes have no potential.
+same steps at the end time with the pseudo-step doubling (the pseudo-mass fading), each converged to a tenth of the
+static residual it starts from, and the static problem once the static residual is small, solved to ``rtol`` (1e-6)
+of the undamped problem. The line search's merit is the incremental potential plus the follower pressure's work
+along the ray, by the trapezoidal rule (the pressure on the leaflets' open surface has no potential).
 
 Output in ``out``: ``state.npz`` after every accepted step (atomic, :mod:`skvalve.valve.state`; ``resume=True``
 continues from it and repeats the uninterrupted run), ``closure.log`` (one line per step), and at the end
