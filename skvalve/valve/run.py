@@ -116,6 +116,9 @@ class _Run:
         self.progress = progress
         self.solver = linsolve.solver_name(options.solver)
         self.lines: list[str] = []
+        # the static relative residual at which the static problem last failed: it is tried again only once the held
+        # steps have lowered the residual tenfold (from an unchanged state it would fail the same way)
+        self.static_failed_at = float("inf")
 
     # ------------------------------------------------------------ kept state
     def resume(self, kept: KeptState) -> None:
@@ -230,9 +233,12 @@ class _Run:
             # do at its tolerance (a held load with hardly any reaction: the relative residual stays large however
             # long the pseudo-step grows)
             idle = self.idle(forcing)
-            static = idle or (np.isfinite(s.relative_residual) and s.relative_residual <= opts.static_below)
+            small = np.isfinite(s.relative_residual) and s.relative_residual <= opts.static_below
+            static = idle or (small and s.relative_residual <= 0.1 * self.static_failed_at)
             outcome = self.attempt(self.end, 0.0, opts.rtol, steps.max_iter) if static else None
             if outcome is None:
+                if static:
+                    self.static_failed_at = s.relative_residual
                 if idle:
                     raise ClosureFailed(f"{s.input}: the static problem at step time {self.end:.6g} failed "
                                         f"({self.last_error}) and a damped held step has nothing left to do at its "
