@@ -62,3 +62,17 @@ def test_damped_held_steps_alone_reach_the_static_equilibrium(monkeypatch):
     reference = _block().problem
     newton = solve(reference, steps=4, rtol=1e-10, progress=False)
     np.testing.assert_allclose(report.u, newton.u(), atol=1e-5 * np.abs(newton.u()).max())
+
+
+def test_a_hard_held_step_keeps_its_pseudo_step():
+    """The held pseudo-step grows only after a step of at most ``easy_iterations`` iterations, as the path's does:
+    with easy_iterations 1, a pseudo-step longer than the one before follows only a step of one iteration, and the
+    held steps still reach the equilibrium."""
+    options = CloseOptions(steps=StepOptions(first=0.25, largest=0.25, damping=1.0, easy_iterations=1),
+                           hold=HoldOptions(max_steps=200))
+    report = run_module.close_valve(None, options, setup=_block(), progress=False)
+    assert report.converged
+    held = [record for record in report.records if record.phase == "hold" and np.isfinite(record.increment)]
+    assert any(record.iterations > 1 for record in held)
+    for before, after in zip(held, held[1:], strict=False):  # a longer pseudo-step only after an easy step
+        assert after.increment <= before.increment or before.iterations <= 1

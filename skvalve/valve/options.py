@@ -136,7 +136,9 @@ class HoldOptions:
     max_steps
         held steps before the run stops with its best state; 0: no held phase (the path only).
     growth
-        the held pseudo-step's growth per converged step (the pseudo-mass falls by it).
+        the held pseudo-step's growth per converged step of at most ``StepOptions.easy_iterations`` iterations (the
+        pseudo-mass falls by it); a harder step keeps its pseudo-step (doubled, the 1.0 diseased valve's held steps
+        failed and were halved back every time).
     """
 
     rtol: float = 1e-6

@@ -251,7 +251,8 @@ class _Run:
                                             f"down to {steps.smallest:g}: {self.last_error}")
                     continue
                 pseudo = s.increment
-                s.increment *= opts.growth
+                if len(outcome[2]) <= steps.easy_iterations:  # as on the path: a hard step's length is kept
+                    s.increment *= opts.growth
             else:
                 pseudo = float("inf")
             u, residual, history = outcome
