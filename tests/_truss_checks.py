@@ -4,6 +4,7 @@ import numpy as np
 import skfem
 
 from skvalve.fem import Solid, Space
+from skvalve.fem.truss import Truss
 from skvalve.materials import NeoHookean
 
 
@@ -22,3 +23,19 @@ def sheared_block():
     solid.add_dirichlet(lambda X: X[0] == 0.0, 0.0)
     solid.add_dirichlet(lambda X: X[0] == 1.0, np.array([0.0, 0.0, 0.5]))
     return solid
+
+
+def two_blocks_with_chord(law, area: float, rest_length: float, slack_stretch: float | None = None):
+    """Two unit blocks 2 apart on the x axis (the second translated to x = 3), a Neo-Hookean solid, and one truss of
+    ``law`` from the centre of the first block's face x = 1 (``face``) to that of the second's face x = 3
+    (``anchor``). Returns ``(solid, chord, face, anchor)``; the caller prescribes the supports."""
+    first = skfem.MeshHex().refined(1)
+    second = skfem.MeshHex().refined(1).translated([3.0, 0.0, 0.0])
+    mesh = skfem.MeshHex(np.hstack([first.p, second.p]), np.hstack([first.t, second.t + first.p.shape[1]]))
+    solid = Solid(mesh, NeoHookean(1.0, 5.0))
+    X = solid.space.dof_coordinates
+    face = np.flatnonzero(np.isclose(X[0], 1.0) & np.isclose(X[1], 0.5) & np.isclose(X[2], 0.5))[0]
+    anchor = np.flatnonzero(np.isclose(X[0], 3.0) & np.isclose(X[1], 0.5) & np.isclose(X[2], 0.5))[0]
+    extra = {} if slack_stretch is None else {"slack_stretch": [slack_stretch]}
+    chord = solid.add_term(Truss(solid.space, [[face, anchor]], area, law, rest_length=[rest_length], **extra))
+    return solid, chord, face, anchor

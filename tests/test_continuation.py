@@ -4,7 +4,7 @@
 import numpy as np
 import pytest
 import skfem
-from _truss_checks import two_nodes
+from _truss_checks import two_blocks_with_chord, two_nodes
 
 from skvalve.fem import NodalForce, Problem, Solid, solve
 from skvalve.fem.amplitudes import GeometricRamp, smooth_step_polynomial
@@ -59,16 +59,8 @@ def test_scaled_chord_against_closed_form():
 def _block_and_slack_cable():
     """A soft block fixed at x = 0; a stiff tension-only cable from the centre of its face x = 1 to a second,
     fully prescribed block 2 apart, whose cable is slack (rest length 2.5) until that block moves away."""
-    block = skfem.MeshHex().refined(1)
-    far = skfem.MeshHex().refined(1).translated([3.0, 0.0, 0.0])
-    mesh = skfem.MeshHex(np.hstack([block.p, far.p]), np.hstack([block.t, far.t + block.p.shape[1]]))
-    solid = Solid(mesh, NeoHookean(1.0, 5.0))
-    X = solid.space.dof_coordinates
-    face = np.flatnonzero(np.isclose(X[0], 1.0) & np.isclose(X[1], 0.5) & np.isclose(X[2], 0.5))[0]
-    anchor = np.flatnonzero(np.isclose(X[0], 3.0) & np.isclose(X[1], 0.5) & np.isclose(X[2], 0.5))[0]
     cable = TensionOnly(LinearUniaxial(1e4), slack_fraction=1e-6, transition=0.01)
-    chord = solid.add_term(Truss(solid.space, [[face, anchor]], 0.05, cable, rest_length=[2.5],
-                                 slack_stretch=[2.0 / 2.5]))
+    solid, chord, _, _ = two_blocks_with_chord(cable, 0.05, 2.5, slack_stretch=2.0 / 2.5)
     solid.add_dirichlet(lambda X: X[0] < 1e-9, 0.0)
     solid.add_dirichlet(lambda X: X[0] > 2.5, lambda X, t: 0.8 * t, components=[0])
     solid.add_dirichlet(lambda X: X[0] > 2.5, 0.0, components=[1, 2])

@@ -3,14 +3,13 @@
 import meshio
 import numpy as np
 import pytest
-import skfem
+from _truss_checks import two_blocks_with_chord
 from scipy.optimize import brentq
 
 from skvalve.analytic import homogeneous
 from skvalve.fem import ConvergenceError, NonPositiveJacobianError, Solid, newton
 from skvalve.fem.meshes import box, rectangle
 from skvalve.fem.problem import Problem
-from skvalve.fem.truss import Truss
 from skvalve.io.timeseries import TimeSeriesWriter
 from skvalve.materials import BimodularNeoHookean, IncompressibleNeoHookean, NeoHookean
 from skvalve.materials.uniaxial import LinearUniaxial, TensionOnly
@@ -217,15 +216,9 @@ def test_reaction_moment_3d_balances():
 def _slack_chord_pulled_taut():
     """Two unit blocks 2 apart, tied face centre to face centre by a tension-only chord of rest length 2.1; the
     second block is moved 0.4 away in two load steps, so the chord turns taut within the first."""
-    first = skfem.MeshHex().refined(1)
-    second = skfem.MeshHex().refined(1).translated([3.0, 0.0, 0.0])
-    both = skfem.MeshHex(np.hstack([first.p, second.p]), np.hstack([first.t, second.t + first.p.shape[1]]))
-    solid = Solid(both, NeoHookean(1.0, 5.0))
-    X = solid.space.dof_coordinates
-    face = np.flatnonzero(np.isclose(X[0], 1.0) & np.isclose(X[1], 0.5) & np.isclose(X[2], 0.5))[0]
-    anchor = np.flatnonzero(np.isclose(X[0], 3.0) & np.isclose(X[1], 0.5) & np.isclose(X[2], 0.5))[0]
     law = TensionOnly(LinearUniaxial(10.0), slack_fraction=1e-4)
-    chord = solid.add_term(Truss(solid.space, [[face, anchor]], 0.2, law, rest_length=[2.1]))
+    solid, chord, _, _ = two_blocks_with_chord(law, 0.2, 2.1)
+    X = solid.space.dof_coordinates
     solid.add_dirichlet(lambda X: X[0] < 1e-9, 0.0)
     moved = np.flatnonzero(X[0] > 2.5)
     solid.add_dirichlet(nodes=moved, value=0.4, components=[0]).add_dirichlet(nodes=moved, value=0.0, components=[1, 2])

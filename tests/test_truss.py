@@ -4,11 +4,12 @@ differences, a single chord against its closed form, a chord tied to a block."""
 import numpy as np
 import pytest
 import skfem
+from _truss_checks import two_blocks_with_chord
 
-from skvalve.fem import NodalForce, Problem, Solid, Space, solve
+from skvalve.fem import NodalForce, Problem, Space, solve
 from skvalve.fem.truss import LawAssignment, Truss, bar_response
 from skvalve.fem.trust_steps import project_psd
-from skvalve.materials import NeoHookean, Ogden
+from skvalve.materials import Ogden
 from skvalve.materials.uniaxial import LinearUniaxial, OgdenUniaxial, TensionOnly
 
 # chordae-like parameters (three terms, one of them with a tiny exponent), MPa
@@ -157,19 +158,9 @@ def test_a_single_truss_with_the_plain_law_carries_compression_beside_a_slack_ch
 def test_chord_tied_to_a_block():
     """A chord pulls the free face of a block: chord force = block reaction, and the chord force equals
     A P(lambda) at the stretch the solve reached (two laws meeting at shared nodes)."""
-    mesh = skfem.MeshHex().refined(1)
-    # a node outside the block, on the chord axis: add it as an extra hex-less node is impossible, so
-    # tie the chord between the centre of the face x = 1 and a node of the face x = 0 of a second block
-    mesh2 = skfem.MeshHex().refined(1).translated([3.0, 0.0, 0.0])
-    p = np.hstack([mesh.p, mesh2.p])
-    t = np.hstack([mesh.t, mesh2.t + mesh.p.shape[1]])
-    both = skfem.MeshHex(p, t)
-    solid = Solid(both, NeoHookean(1.0, 5.0))
-    X = solid.space.dof_coordinates
-    face = np.flatnonzero(np.isclose(X[0], 1.0) & np.isclose(X[1], 0.5) & np.isclose(X[2], 0.5))[0]
-    anchor = np.flatnonzero(np.isclose(X[0], 3.0) & np.isclose(X[1], 0.5) & np.isclose(X[2], 0.5))[0]
     area, rest = 0.2, 1.9  # pre-stretched: rest length below the 2.0 gap
-    chord = solid.add_term(Truss(solid.space, [[face, anchor]], area, LinearUniaxial(10.0), rest_length=[rest]))
+    solid, chord, face, anchor = two_blocks_with_chord(LinearUniaxial(10.0), area, rest)
+    X = solid.space.dof_coordinates
     solid.add_dirichlet(lambda X: X[0] < 1e-9, 0.0)
     second = np.flatnonzero(X[0] > 2.5)
     solid.add_dirichlet(nodes=second, value=0.0)

@@ -35,6 +35,7 @@ from ..fem import linsolve
 from ..fem.errors import NonPositiveJacobianError, SingularSystemError, SolverError
 from ..fem.incremental import IncrementalOptions, StepFailed, minimise_step
 from ..fem.newton import reference_force
+from ..fem.problem import Problem
 from ..io.abaqus import AbaqusModel
 from ..io.files import replace_atomically
 from .options import CloseOptions
@@ -42,7 +43,7 @@ from .outputs import ClosureWriter
 from .setup import ValveSetup, smallest_corner_jacobian, valve_setup
 from .state import KeptState, read_state, write_state
 
-__all__ = ["ClosureFailed", "CloseReport", "StepRecord", "close_valve"]
+__all__ = ["ClosureFailed", "CloseReport", "StepRecord", "close_valve", "relative_residual"]
 
 logger = logging.getLogger("skvalve.valve")
 
@@ -99,6 +100,13 @@ class CloseReport:
                 f"{'YES' if self.intersects else 'none'}; smallest corner Jacobian {self.smallest_jacobian:.3g}; "
                 f"{self.contact_pairs} contact pairs, contact area {self.contact_area:.1f} mm^2; "
                 f"{self.seconds:.1f} s")
+
+
+def relative_residual(problem: Problem, residual: np.ndarray) -> float:
+    """The static relative residual: the free components' norm over the reactions' and loads' scale
+    (:func:`~skvalve.fem.newton.reference_force`), as the closure reports and converges it."""
+    pattern = problem.pattern
+    return float(np.linalg.norm(residual[pattern.free]) / reference_force(problem, residual, pattern.fixed))
 
 
 class _Run:
@@ -167,8 +175,7 @@ class _Run:
         problem = self.problem
         problem.commit()
         problem.check_state(u, t)
-        relative = float(np.linalg.norm(residual[problem.pattern.free])
-                          / reference_force(problem, residual, problem.pattern.fixed))
+        relative = relative_residual(problem, residual)
         s = self.state
         s.u, s.t, s.relative_residual = u, float(t), relative
         s.iterations += len(history)

@@ -31,11 +31,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ...fem.newton import reference_force
 from ...io.abaqus import trivalve_input, trivalve_inputs
 from ...valve.options import CloseOptions
 from ...valve.outputs import ClosureWriter, closure_measures
-from ...valve.run import STATE_FILE, ClosureFailed, close_valve
+from ...valve.run import STATE_FILE, ClosureFailed, close_valve, relative_residual
 from ...valve.setup import ValveSetup, valve_setup
 from ...valve.state import KeptState, StateError, read_state
 from ...valve.support import UnsupportedInputError
@@ -110,10 +109,8 @@ def state_input(state: Path, inputs: dict[str, Path]) -> tuple[str, KeptState, V
 
 def static_residual(setup: ValveSetup, u: np.ndarray, t: float) -> float:
     """The static relative residual at ``(u, t)``, as :func:`~skvalve.valve.run.close_valve` measures it."""
-    problem = setup.problem
-    residual, _ = problem.assemble(u, t, tangent=False)
-    return float(np.linalg.norm(residual[problem.pattern.free]) / reference_force(problem, residual,
-                                                                                   problem.pattern.fixed))
+    residual, _ = setup.problem.assemble(u, t, tangent=False)
+    return relative_residual(setup.problem, residual)
 
 
 def _open(setup: ValveSetup):
