@@ -126,6 +126,25 @@ def test_both_directions_reach_the_same_contact_equilibrium_and_shifted_newton_e
 def test_unknown_direction_is_named():
     with pytest.raises(ValueError, match="direction"):
         IncrementalOptions(direction="steepest")
+    with pytest.raises(ValueError, match="reference"):
+        IncrementalOptions(reference=0.0)
+
+
+def test_a_fixed_reference_force_sets_the_tolerance():
+    """``reference`` replaces Newton's scale (the reactions' norm) in the convergence test: a block stretched by a
+    prescribed end motion, converged to rtol x reference, leaves a residual below it, and a reference 1e4 times larger
+    stops after fewer iterations."""
+    def stretched(reference):
+        solid = Solid(box((2, 2, 2)), NeoHookean.from_shear_poisson(1.0, 0.3))
+        solid.add_dirichlet("left", 0.0)
+        solid.add_dirichlet("right", [0.2, 0.0, 0.0])
+        options = IncrementalOptions(rtol=1e-6, reference=reference)
+        return solid, incremental_potential(solid, steps=1, options=options, progress=False)
+
+    solid, tight = stretched(1e-3)
+    _, loose = stretched(10.0)
+    assert np.linalg.norm(tight.residuals[-1][solid.pattern.free]) <= 1e-6 * 1e-3
+    assert len(loose.histories[-1]) < len(tight.histories[-1])
 
 
 def _bent_strip(solver):

@@ -250,6 +250,8 @@ def test_bad_input_is_named():
         IPCContact(space, dhat=0.0, stiffness=1.0)
     with pytest.raises(ValueError, match="stiffness"):
         IPCContact(space, dhat=0.1, stiffness=float("nan"))
+    with pytest.raises(ValueError, match="threads"):
+        IPCContact(space, dhat=0.1, stiffness=1.0, threads=0)
     with pytest.raises(ValueError, match="obstacle 'arm'"):
         Obstacle(np.zeros((3, 3)), [[0, 1, 5]], name="arm")
     with pytest.raises(ValueError, match="plane"):

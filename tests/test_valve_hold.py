@@ -8,6 +8,7 @@ first held steps did that: 0 iterations each, the residual unchanged)."""
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 
 from skvalve.fem import Solid
 from skvalve.fem.contact import IPCContact
@@ -17,7 +18,7 @@ from skvalve.fem.newton import solve
 from skvalve.materials import NeoHookean
 from skvalve.valve import run as run_module
 from skvalve.valve.options import CloseOptions, HoldOptions, StepOptions
-from skvalve.valve.setup import ValveSetup
+from skvalve.valve.setup import ValveSetup, end_load_norm
 
 PRESSURE = 0.05
 
@@ -33,7 +34,8 @@ def _block() -> ValveSetup:
     model = SimpleNamespace(mesh=mesh, end_time=1.0, pressures=[SimpleNamespace(at=lambda t: np.array([PRESSURE * t]))])
     n = mesh.p.shape[1]
     volumes = np.full(3 * n, 1.0 / n)
-    return ValveSetup(None, model, solid, contact, np.zeros(n, dtype=np.int64), volumes, "block", PRESSURE)
+    return ValveSetup(None, model, solid, contact, np.zeros(n, dtype=np.int64), volumes, "block",
+                      end_load_norm(solid, 1.0))
 
 
 def test_damped_held_steps_alone_reach_the_static_equilibrium(monkeypatch):
@@ -76,3 +78,13 @@ def test_a_hard_held_step_keeps_its_pseudo_step():
     assert any(record.iterations > 1 for record in held)
     for before, after in zip(held, held[1:], strict=False):  # a longer pseudo-step only after an easy step
         assert after.increment <= before.increment or before.iterations <= 1
+
+
+def test_end_load_norm_is_the_pressure_nodal_forces_norm():
+    """The closure's force scale on the block: the x = 1 face (2 x 2 bilinear facets of 1/4) under p carries nodal
+    forces p/16 at its 4 corners, p/8 at its 4 edge midpoints and p/4 at its centre: norm 0.375 p."""
+    setup = _block()
+    assert setup.load_norm == pytest.approx(0.375 * PRESSURE, rel=1e-12)
+    assert end_load_norm(setup.problem, 0.5) == pytest.approx(0.5 * 0.375 * PRESSURE, rel=1e-12)  # ramped
+    with pytest.raises(ValueError, match="no pressure"):
+        end_load_norm(setup.problem, 0.0)

@@ -37,7 +37,9 @@ is moved to the zero of the slope's secant. Where a term has no potential (a fol
 not conservative) the merit is the residual norm instead (``energy_merit`` False in the history): the line search
 then asks that :math:`|\nabla E|` falls, and every iteration takes the unprojected tangent, whose direction is a
 descent direction of :math:`|\nabla E|` by construction.
-Converged: :math:`\lVert \nabla E_f\rVert \le \max(\text{rtol}\,f_\text{ref}, \text{atol})` (Newton's measure).
+Converged: :math:`\lVert \nabla E_f\rVert \le \max(\text{rtol}\,f_\text{ref}, \text{atol})`, with :math:`f_\text{ref}`
+Newton's measure (the reactions' and loads' norm) or a fixed force ``reference`` the caller knows better (e.g. the
+end load's nodal forces where reactions concentrated at a few nodes would dwarf a distributed load).
 """
 
 from __future__ import annotations
@@ -82,6 +84,7 @@ class IncrementalOptions:
 
     rtol: float = 1e-8
     atol: float = 0.0
+    reference: float | None = None
     max_iter: int = 60
     max_cutbacks: int = 8
     max_line_search: int = 40
@@ -102,6 +105,8 @@ class IncrementalOptions:
                 raise ValueError(f"{name} must be a finite number >= 0; got {value!r}")
         if not self.rtol > 0.0:
             raise ValueError(f"rtol must be positive; got {self.rtol!r}")
+        if self.reference is not None and not (math.isfinite(self.reference) and self.reference > 0.0):
+            raise ValueError(f"reference must be None or a finite force > 0; got {self.reference!r}")
         if self.direction not in DIRECTIONS:
             raise ValueError(f"direction must be one of {DIRECTIONS}; got {self.direction!r}")
         for name in ("max_iter", "max_cutbacks", "max_line_search", "stall_iterations", "secant_steps"):
@@ -249,8 +254,12 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
     newton_allowed = True  # False once a full-tangent step raised |grad E| (a non-convex region: stay projected)
     shifted = opts.direction == "shifted" and solver == "pardiso"
     shift = 0.0
+    def scale(residual: np.ndarray) -> float:
+        """The relative residual's force scale: ``opts.reference``, else the reactions' and loads' norm."""
+        return opts.reference if opts.reference is not None else reference_force(problem, residual, fixed)
+
     for iteration in range(1, opts.max_iter + 1):
-        reference = reference_force(problem, residual, fixed)
+        reference = scale(residual)
         norm = float(np.linalg.norm(gradient[free]))
         if norm <= max(opts.rtol * reference, opts.atol):
             return u, residual, history
@@ -303,7 +312,7 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
                         "relative_residual": float(np.linalg.norm(gradient[free])) / reference,
                         "seconds": time.perf_counter() - clock})
     raise StepFailed(f"no convergence in {opts.max_iter} iterations (relative residual "
-                      f"{float(np.linalg.norm(gradient[free])) / reference_force(problem, residual, fixed):.3e})")
+                      f"{float(np.linalg.norm(gradient[free])) / scale(residual):.3e})")
 
 
 @dataclass

@@ -95,8 +95,9 @@ class StepOptions:
         length (0.003-0.02 of step time: a chordae branch point between stiff struts sets the count, not the load
         increment), so a smaller bound kept the steps at their smallest.
     rtol
-        each path step's tolerance (relative to the reactions and the end load); the path needs no tighter
-        equilibria: the held load is solved to ``HoldOptions.rtol``.
+        each path step's tolerance, relative to the end load's nodal pressure forces
+        (:func:`~skvalve.valve.setup.end_load_norm`, as every relative residual of the closure): a step leaves at
+        most this share of the pressure unbalanced; the held load is then solved to ``HoldOptions.rtol``.
     max_iter
         iterations per step before it is cut back.
     """
@@ -130,7 +131,7 @@ class HoldOptions:
     of the static residual it starts from (not below ``rtol``), then the static problem.
 
     rtol
-        the undamped, static residual asked for (relative to reactions and loads).
+        the undamped, static residual asked for (relative to the end load's nodal pressure forces).
     static_below
         once a held step leaves a static residual below this, the static problem is tried directly.
     max_steps

@@ -34,8 +34,6 @@ from tqdm.auto import tqdm
 from ..fem import linsolve
 from ..fem.errors import NonPositiveJacobianError, SingularSystemError, SolverError
 from ..fem.incremental import IncrementalOptions, StepFailed, minimise_step
-from ..fem.newton import reference_force
-from ..fem.problem import Problem
 from ..io.abaqus import AbaqusModel
 from ..io.files import replace_atomically
 from .options import CloseOptions
@@ -102,11 +100,10 @@ class CloseReport:
                 f"{self.seconds:.1f} s")
 
 
-def relative_residual(problem: Problem, residual: np.ndarray) -> float:
-    """The static relative residual: the free components' norm over the reactions' and loads' scale
-    (:func:`~skvalve.fem.newton.reference_force`), as the closure reports and converges it."""
-    pattern = problem.pattern
-    return float(np.linalg.norm(residual[pattern.free]) / reference_force(problem, residual, pattern.fixed))
+def relative_residual(setup: ValveSetup, residual: np.ndarray) -> float:
+    """The static relative residual: the free components' norm over the end load's nodal pressure forces
+    (:func:`~skvalve.valve.setup.end_load_norm`), as the closure reports and converges it."""
+    return float(np.linalg.norm(residual[setup.problem.pattern.free]) / setup.load_norm)
 
 
 class _Run:
@@ -150,10 +147,9 @@ class _Run:
     def step(self, t_new: float, inertia_scale: float, rtol: float, max_iter: int):
         """A minimisation from the kept state to ``t_new`` with the pseudo-mass ``inertia_scale`` x volumes."""
         s = self.state
-        # the path's steps: also converged below rtol x the end load's scale (in the papillary stage the reactions
-        # are nearly zero, and a tolerance relative to them alone asks for more than the path needs)
-        atol = rtol * self.setup.load_scale if inertia_scale > 0.0 else 0.0
-        opts = IncrementalOptions(rtol=rtol, atol=atol, max_iter=max_iter, solver=self.options.solver)
+        # converged relative to the end load's nodal forces (end_load_norm), as the static residual is reported
+        opts = IncrementalOptions(rtol=rtol, reference=self.setup.load_norm, max_iter=max_iter,
+                                  solver=self.options.solver)
         inertia = inertia_scale * self.setup.volumes
         u, residual, history = minimise_step(self.problem, s.u, s.t, t_new, s.u, inertia,
                                              s.steps + s.held_steps + 1, opts, self.solver)
@@ -175,20 +171,17 @@ class _Run:
         problem = self.problem
         problem.commit()
         problem.check_state(u, t)
-        relative = relative_residual(problem, residual)
+        relative = relative_residual(self.setup, residual)
         s = self.state
         s.u, s.t, s.relative_residual = u, float(t), relative
         s.iterations += len(history)
         return relative
 
     def idle(self, rtol: float) -> bool:
-        """True when the kept state already meets a damped step's convergence test at ``rtol`` (:meth:`step`: below
-        ``rtol`` times the larger of the reactions' and loads' scale and the end load's), so that a damped held step
-        would accept it without an iteration."""
-        problem = self.problem
-        residual, _ = problem.assemble(self.state.u, self.end, tangent=False)
-        scale = max(reference_force(problem, residual, problem.pattern.fixed), self.setup.load_scale)
-        return float(np.linalg.norm(residual[problem.pattern.free])) <= rtol * scale
+        """True when the kept state already meets a damped step's convergence test at ``rtol`` (:meth:`step`), so
+        that a damped held step would accept it without an iteration."""
+        residual, _ = self.problem.assemble(self.state.u, self.end, tangent=False)
+        return relative_residual(self.setup, residual) <= rtol
 
     # ------------------------------------------------------------ phases
     def path(self, bar) -> None:

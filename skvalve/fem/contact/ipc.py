@@ -132,6 +132,10 @@ class IPCContact(Term):
         (ipctk ``has_intersections``; costs a full check: for debug runs and tests).
     adaptive : raise :math:`\kappa` as IPC does after steps that bring surfaces very close (off: a fixed problem).
     self_contact : False to drop contact of the body with itself (obstacles and planes only).
+    threads : ipctk's thread count, a process-wide setting (None: leave it as it is). 1 by default: ipctk's threaded
+        sums differ in the last bits from run to run, and a closure whose path branches (a symmetric two-leaflet
+        valve whose free edges meet) then took 118-121 iterations to different states in four runs; on one thread the
+        runs are bitwise the same (``tests/test_valve_close_mini.py``).
     """
 
     name = "ipc contact"
@@ -140,7 +144,11 @@ class IPCContact(Term):
     def __init__(self, space: Space, surface: ContactSurface | None = None, *, dhat: float, stiffness: float,
                  obstacles: Sequence[Obstacle] = (), planes: Sequence[Plane] = (), exclude_within: float = 0.0,
                  friction: Friction | None = None, check_intersections: bool = False, adaptive: bool = False,
-                 self_contact: bool = True) -> None:
+                 self_contact: bool = True, threads: int | None = 1) -> None:
+        if threads is not None:
+            if not isinstance(threads, int) or isinstance(threads, bool) or threads < 1:
+                raise ValueError(f"ipc contact: threads must be None or an integer >= 1; got {threads!r}")
+            ipctk.set_num_threads(threads)
         if space.dim != 3 or space.order != 1:
             raise ValueError("ipc contact: needs a linear 3D displacement space")
         if not (np.isfinite(dhat) and dhat > 0.0):

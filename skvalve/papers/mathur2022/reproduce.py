@@ -110,7 +110,7 @@ def state_input(state: Path, inputs: dict[str, Path]) -> tuple[str, KeptState, V
 def static_residual(setup: ValveSetup, u: np.ndarray, t: float) -> float:
     """The static relative residual at ``(u, t)``, as :func:`~skvalve.valve.run.close_valve` measures it."""
     residual, _ = setup.problem.assemble(u, t, tangent=False)
-    return relative_residual(setup.problem, residual)
+    return relative_residual(setup, residual)
 
 
 def _open(setup: ValveSetup):
