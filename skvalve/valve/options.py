@@ -84,11 +84,12 @@ class StepOptions:
     held load.
 
     damping
-        :math:`c` (N·s/mm⁴ per unit step time). 1e-3: on the 1.0 diseased valve's early pressure stage (from step
-        time 0.535, same machine and load) the steps with 1e-4 wandered (Marquardt shifts of 0.01-1 |diag|, the
-        residual rising 40-fold within a step) and were cut back to 0.001-0.003 of step time: 3 steps in 9 minutes;
-        with 1e-3, 7 steps to 0.640 with no cut-back, the step growing to 0.033. The viscous force it leaves on the
-        path (a few % of the pressure's nodal forces while the leaflets move) is removed by the held steps.
+        :math:`c` (N·s/mm⁴ per unit step time). 1e-3: on the 1.0 diseased valve's early pressure stage (from
+        step time 0.535, same machine and load) the steps with 1e-4 wandered (Marquardt shifts of 0.01-1 times the
+        diagonal, the residual rising 40-fold within a step) and were cut back to 0.001-0.003 of step time: 3 steps in
+        9 minutes; with 1e-3, 7 steps to 0.640 with no cut-back, the step growing to 0.033. The viscous force it
+        leaves on the path (a few % of the pressure's nodal forces while the leaflets move) is removed by the held
+        steps.
     first, largest, smallest
         the first, largest and smallest step (step time); a failed step is halved, and the run
         stops with the step and step time when it falls below ``smallest``.
