@@ -21,8 +21,6 @@ import numpy as np
 LEAFLET_LAW = (1.0e-2, 20.0, 2.0e-3, 20.0)
 CHORD_LAW = (4.0, 20.0, 4.0, 20.0, 4.0, 20.0, 5.0e-4, 0.0, 0.0)
 CHORD_AREA = 0.3
-#: S1..S6 of a C3D8 brick as its local corner indices (Abaqus's face numbering)
-_FACES = {"S1": (0, 1, 2, 3), "S2": (4, 5, 6, 7)}
 
 
 def _leaflet(side: float, width: float, height: float, thickness: float, gap: float, nw: int, nh: int):
@@ -91,15 +89,12 @@ def write_mini_valve(path: str | Path, pressure: float = 0.004, pull: float = 0.
             label += 1
             lines.append(f"{label}, " + ", ".join(str(int(n) + 1) for n in row))
         elements.append((name, first, label))
-    chord_elements = {}
     for name in ("A", "B"):
         lines.append(f"*Element, type=T3D2, elset={name}_Chordae")
-        first = label + 1
         for owner, i, j in chords:
             if owner == name:
                 label += 1
                 lines.append(f"{label}, {i + 1}, {j + 1}")
-        chord_elements[name] = (first, label)
     for name, first, last in elements:
         lines += [f"*Elset, elset={name}_Outer, generate", f"{first}, {last}, 1"]
     for name, *_ in leaflets:

@@ -19,10 +19,9 @@ import pytest
 from _mini_valve import write_mini_valve
 
 from skvalve.cli import main
-from skvalve.fem.loads import FollowerPressure
 from skvalve.valve.options import CloseOptions
 from skvalve.valve.run import close_valve, relative_residual
-from skvalve.valve.setup import valve_setup
+from skvalve.valve.setup import pressure_forces, valve_setup
 from skvalve.valve.state import read_state
 
 GAP, WIDTH, HEIGHT, NH = 4.0, 8.0, 6.0, 3
@@ -57,10 +56,7 @@ def test_reactions_balance_the_pressure(closed):
     kept = read_state(out / "state.npz")
     problem = setup.problem
     residual, _ = problem.assemble(kept.u, kept.t, tangent=False)
-    pressure = np.zeros(problem.space.n_dofs)
-    for term in problem.terms:
-        if isinstance(term, FollowerPressure):
-            pressure += term.assemble(kept.u, kept.t, tangent=False).external
+    pressure = pressure_forces(problem, kept.u, kept.t)
     fixed = np.zeros(problem.space.n_dofs, dtype=bool)
     fixed[problem.pattern.fixed] = True
     n_u = problem.space.n_u
@@ -75,15 +71,15 @@ def test_the_leaflets_coapt(closed):
     than d^ to a triangle of the other (ipctk's point-triangle distance), and the contact area lies between the
     free-edge strip and the two leaflets' whole faces."""
     _, out, setup = closed
-    u = read_state(out / "state.npz").u[: setup.problem.space.n_u].reshape(-1, 3)
+    kept = read_state(out / "state.npz")
     X = setup.model.mesh.p.T
-    x = X + u
+    x = X + kept.u[: setup.problem.space.n_u].reshape(-1, 3)
     a = np.flatnonzero(np.isclose(X[:, 0], 0.5 * GAP))
     triangles = setup.contact.surface.triangles
     b = triangles[np.all(np.isclose(X[triangles, 0], -0.5 * GAP), axis=1)]
     closest = min(np.sqrt(ipctk.point_triangle_distance(x[i], *x[t])) for i in a for t in b)
     assert 0.0 < closest < CloseOptions().contact.dhat
-    area = setup.contact.contact_area(read_state(out / "state.npz").u, 1.5)
+    area = setup.contact.contact_area(kept.u, kept.t)
     strip = WIDTH * HEIGHT / NH  # one row of faces along the free edge
     assert 2 * strip < area < 2 * WIDTH * HEIGHT
 

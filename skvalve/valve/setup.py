@@ -23,7 +23,7 @@ from .extrude import hex_corner_jacobians
 from .model import ABAQUS_TO_SKFEM_HEX, ValveModel, valve_model
 from .options import CloseOptions
 
-__all__ = ["ValveSetup", "end_load_norm", "smallest_corner_jacobian", "valve_setup"]
+__all__ = ["ValveSetup", "end_load_norm", "pressure_forces", "smallest_corner_jacobian", "valve_setup"]
 
 
 @dataclass
@@ -66,6 +66,15 @@ def valve_setup(source: str | Path | AbaqusModel, options: CloseOptions | None =
                       end_load_norm(problem, model.end_time))
 
 
+def pressure_forces(problem: Problem, u: np.ndarray, t: float) -> np.ndarray:
+    """The follower pressures' nodal forces (all dofs) at ``(u, t)``: the external load the leaflets carry."""
+    force = np.zeros(problem.space.n_dofs)
+    for term in problem.terms:
+        if isinstance(term, FollowerPressure):
+            force += term.assemble(u, t, tangent=False).external
+    return force
+
+
 def end_load_norm(problem: Problem, t_end: float) -> float:
     r"""The closure's force scale: :math:`\lVert f_p\rVert_2`, the follower pressures' nodal forces at step time
     ``t_end`` on the reference geometry, over the free dofs (N).
@@ -75,10 +84,7 @@ def end_load_norm(problem: Problem, t_end: float) -> float:
     the 1.0 diseased valve against :math:`\lVert f_p\rVert_2` = 0.215 N), and a residual 1e-3 of it left 18 % of
     the pressure unbalanced: the load path arrived at the end load with the valve open in the middle.
     """
-    force = np.zeros(problem.space.n_dofs)
-    for term in problem.terms:
-        if isinstance(term, FollowerPressure):
-            force += term.assemble(np.zeros(problem.space.n_dofs), t_end, tangent=False).external
+    force = pressure_forces(problem, np.zeros(problem.space.n_dofs), t_end)
     norm = float(np.linalg.norm(force[problem.pattern.free]))
     if not norm > 0.0:
         raise ValueError(f"no pressure load on the free dofs at step time {t_end:g}: the closure's force scale is the "
