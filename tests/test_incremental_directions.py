@@ -35,7 +35,7 @@ def _laplacian(n: int, shift: float) -> sp.csr_matrix:
 def test_shifted_newton_is_newton_on_a_definite_matrix():
     H = _laplacian(30, 0.1)
     rhs = np.random.default_rng(0).standard_normal(30)
-    direction, shift = shifted_newton(H, rhs, 0.0, "pardiso")
+    direction, shift, _ = shifted_newton(H, rhs, 0.0, "pardiso")
     assert shift == 0.0
     np.testing.assert_allclose(direction, np.linalg.solve(H.toarray(), rhs), rtol=1e-10)
 
@@ -44,23 +44,51 @@ def test_shifted_newton_takes_the_smallest_definite_shift_of_its_sequence():
     """lambda_min(H) = -0.3 at a diagonal of ~2: the shift is the first mu of 1e-6 x 10^k with H + mu diag(H) > 0."""
     H = _laplacian(30, -0.3)
     rhs = np.random.default_rng(1).standard_normal(30)
-    direction, shift = shifted_newton(H, rhs, 0.0, "pardiso")
+    direction, shift, _ = shifted_newton(H, rhs, 0.0, "pardiso")
     D = np.abs(H.diagonal())
     lowest = lambda mu: np.linalg.eigvalsh(H.toarray() + mu * np.diag(D))[0]
     assert lowest(shift) > 0.0 and lowest(shift / SHIFT_GROWTH) <= 0.0
     assert np.log10(shift / FIRST_SHIFT) == pytest.approx(round(np.log10(shift / FIRST_SHIFT)))
     assert rhs @ direction > 0.0  # a descent direction for the gradient -rhs
     # warm start: from a larger last shift the sequence starts a hundredth below it and ends at a definite one
-    _, again = shifted_newton(H, rhs, 1e3 * shift, "pardiso")
+    _, again, _ = shifted_newton(H, rhs, 1e3 * shift, "pardiso")
     assert again == pytest.approx(10 * shift) and lowest(again) > 0.0
 
 
 def test_a_negative_pivot_is_lifted_by_its_own_diagonal():
     """diag(1, -1, 2): definite once mu |diag| lifts the -1 past 0, so mu = 10 (mu = 1 makes it singular)."""
     H = sp.csr_matrix(np.diag([1.0, -1.0, 2.0]))
-    direction, shift = shifted_newton(H, np.ones(3), 0.0, "pardiso")
+    direction, shift, _ = shifted_newton(H, np.ones(3), 0.0, "pardiso")
     assert shift == pytest.approx(10.0)
     np.testing.assert_allclose(direction, [1.0 / 11.0, 1.0 / 9.0, 1.0 / 22.0], rtol=1e-12)
+
+
+def test_an_indefinite_tangent_falls_back_to_its_projection_unshifted():
+    """With a ``fallback`` (the element-projected matrix): Newton's step where H is definite; where it is not, the
+    fallback's own step with no shift when the fallback is definite, and its smallest definite shift otherwise."""
+    rhs = np.random.default_rng(2).standard_normal(30)
+    definite, indefinite = _laplacian(30, 0.1), _laplacian(30, -0.3)
+    projection = _laplacian(30, 0.5)
+    calls = []
+
+    def fallback():
+        calls.append(1)
+        return projection
+
+    direction, shift, projected = shifted_newton(definite, rhs, 0.0, "pardiso", fallback=fallback)
+    assert (shift, projected, calls) == (0.0, False, [])
+    np.testing.assert_allclose(direction, np.linalg.solve(definite.toarray(), rhs), rtol=1e-10)
+    direction, shift, projected = shifted_newton(indefinite, rhs, 0.0, "pardiso", fallback=fallback)
+    assert (shift, projected, len(calls)) == (0.0, True, 1)
+    np.testing.assert_allclose(direction, np.linalg.solve(projection.toarray(), rhs), rtol=1e-10)
+    # told that H was indefinite a moment ago, it goes straight to the fallback, even where H is definite now
+    direction, shift, projected = shifted_newton(definite, rhs, 0.0, "pardiso", fallback=fallback, newton_first=False)
+    assert (shift, projected, len(calls)) == (0.0, True, 2)
+    np.testing.assert_allclose(direction, np.linalg.solve(projection.toarray(), rhs), rtol=1e-10)
+    # an indefinite fallback takes its own smallest definite shift, as the plain sequence does on it
+    _, alone, _ = shifted_newton(indefinite, rhs, 0.0, "pardiso")
+    _, shift, projected = shifted_newton(_laplacian(30, -0.5), rhs, 0.0, "pardiso", fallback=lambda: indefinite)
+    assert projected and shift == pytest.approx(alone)
 
 
 class _Quadratic:

@@ -132,7 +132,10 @@ class StepOptions:
 @dataclass(frozen=True)
 class HoldOptions:
     """The held load at the end: pseudo-steps whose pseudo-mass fades (the step doubles), each converged to a tenth
-    of the static residual it starts from (not below ``rtol``), then the static problem.
+    of the static residual it starts from (not below ``rtol``), then the static problem. A held step that runs out of
+    iterations (``StepOptions.max_iter``) is kept, marked unconverged, when its last iterate lowered the static
+    residual: the held phase only has to make progress towards the equilibrium, and on the 1.0 diseased valve a
+    discarded step threw away 40 iterations (2-4 minutes) that had moved the leaflets towards it.
 
     rtol
         the undamped, static residual asked for (relative to the end load's nodal pressure forces).
@@ -141,9 +144,10 @@ class HoldOptions:
     max_steps
         held steps before the run stops with its best state; 0: no held phase (the path only).
     growth
-        the held pseudo-step's growth per converged step of at most ``StepOptions.easy_iterations`` iterations (the
-        pseudo-mass falls by it); a harder step keeps its pseudo-step (doubled, the 1.0 diseased valve's held steps
-        failed and were halved back every time).
+        the held pseudo-step's growth after each converged held step (the pseudo-mass falls by it); a step kept
+        unconverged keeps its pseudo-step, a failed one halves it. On the 1.0 diseased valve the held steps took
+        20-40 iterations at every pseudo-step, so growing only after easy steps (as the path does) kept the
+        pseudo-mass at its path value: the static residual fell 1-2 % per held step.
     """
 
     rtol: float = 1e-6

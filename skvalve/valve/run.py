@@ -10,9 +10,10 @@ repair afterwards.
 Path (:class:`~skvalve.valve.options.StepOptions`): incremental-potential steps
 (:func:`~skvalve.fem.incremental.minimise_step`) with a viscous pseudo-mass :math:`cV_i/\Delta t`, whose length
 grows after easy steps and halves after failed ones. Held load (:class:`~skvalve.valve.options.HoldOptions`): the
-same steps at the end time with the pseudo-step doubling (the pseudo-mass fading), each converged to a tenth of the
-static residual it starts from, and the static problem once the static residual is small, solved to ``rtol`` (1e-6)
-of the undamped problem. The line search's merit is the incremental potential plus the follower pressure's work
+same steps at the end time with the pseudo-step doubling after each converged one (the pseudo-mass fading), each
+converged to a tenth of the static residual it starts from (or, out of iterations, kept when it lowered the static
+residual), and the static problem once the static residual is small, solved to ``rtol`` (1e-6) of the undamped
+problem. The line search's merit is the incremental potential plus the follower pressure's work
 along the ray, by the trapezoidal rule (the pressure on the leaflets' open surface has no potential).
 
 Output in ``out``: ``state.npz`` after every accepted step (atomic, :mod:`skvalve.valve.state`; ``resume=True``
@@ -27,6 +28,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -64,11 +66,12 @@ class StepRecord:
     relative_residual: float
     contact_pairs: int
     seconds: float
+    converged: bool = True  # False: a held step kept for its progress after it ran out of iterations
 
     def line(self) -> str:
         return (f"{self.phase} t={self.t:.6g} dt={self.increment:.3g} iterations={self.iterations} "
                 f"relative_residual={self.relative_residual:.3e} contact_pairs={self.contact_pairs} "
-                f"seconds={self.seconds:.2f}")
+                f"seconds={self.seconds:.2f}{'' if self.converged else ' unconverged'}")
 
 
 @dataclass
@@ -104,6 +107,15 @@ def relative_residual(setup: ValveSetup, residual: np.ndarray) -> float:
     """The static relative residual: the free components' norm over the end load's nodal pressure forces
     (:func:`~skvalve.valve.setup.end_load_norm`), as the closure reports and converges it."""
     return float(np.linalg.norm(residual[setup.problem.pattern.free]) / setup.load_norm)
+
+
+class _Outcome(NamedTuple):
+    """A step's end: state, static residual (all dofs), iteration history, whether it met its tolerance."""
+
+    u: np.ndarray
+    residual: np.ndarray
+    history: list[dict]
+    converged: bool
 
 
 class _Run:
@@ -155,11 +167,20 @@ class _Run:
                                              s.steps + s.held_steps + 1, opts, self.solver)
         return u, residual, history
 
-    def attempt(self, t_new: float, inertia_scale: float, rtol: float, max_iter: int):
-        """:meth:`step`, or ``None`` after rewinding the terms when it fails."""
+    def attempt(self, t_new: float, inertia_scale: float, rtol: float, max_iter: int,
+                progress_only: bool = False) -> _Outcome | None:
+        """:meth:`step`, or ``None`` after rewinding the terms when it fails. ``progress_only``: a step that ran out
+        of iterations is still kept (unconverged) when its last iterate's static residual is below the kept
+        state's (a held step only has to make progress towards the static equilibrium)."""
         try:
-            return self.step(t_new, inertia_scale, rtol, max_iter)
+            return _Outcome(*self.step(t_new, inertia_scale, rtol, max_iter), True)
         except (StepFailed, NonPositiveJacobianError, SingularSystemError, np.linalg.LinAlgError) as err:
+            last = getattr(err, "last", None) if progress_only else None
+            if last is not None and relative_residual(self.setup, last[1]) < self.state.relative_residual:
+                u, _, history = last
+                residual, _ = self.problem.assemble(u, t_new, tangent=False)  # the terms' last state is u's
+                logger.info("held step to t=%.6g kept unconverged after %d iterations: %s", t_new, len(history), err)
+                return _Outcome(u, residual, history, False)
             self.problem.rewind()
             self.failed += 1
             logger.info("step to t=%.6g failed: %s", t_new, err)
@@ -197,7 +218,7 @@ class _Run:
                     raise ClosureFailed(f"{s.input}: load step {s.steps + 1} from step time {s.t:.6g} failed at "
                                         f"every length down to {opts.smallest:g}: {self.last_error}")
                 continue
-            u, residual, history = outcome
+            u, residual, history, _ = outcome
             step_length = t_new - s.t
             relative = self.accept(u, t_new, residual, history)
             s.steps += 1
@@ -243,7 +264,8 @@ class _Run:
                     raise ClosureFailed(f"{s.input}: the static problem at step time {self.end:.6g} failed "
                                         f"({self.last_error}) and a damped held step has nothing left to do at its "
                                         "tolerance (the kept state is the last one)")
-                outcome = self.attempt(self.end, steps.damping / s.increment, forcing, steps.max_iter)
+                outcome = self.attempt(self.end, steps.damping / s.increment, forcing, steps.max_iter,
+                                       progress_only=True)
                 if outcome is None:
                     s.increment *= 0.5
                     if s.increment < steps.smallest:
@@ -251,18 +273,18 @@ class _Run:
                                             f"down to {steps.smallest:g}: {self.last_error}")
                     continue
                 pseudo = s.increment
-                if len(outcome[2]) <= steps.easy_iterations:  # as on the path: a hard step's length is kept
+                if outcome.converged:  # each converged held step lets the pseudo-mass fade (HoldOptions.growth)
                     s.increment *= opts.growth
             else:
                 pseudo = float("inf")
-            u, residual, history = outcome
+            u, residual, history, converged = outcome
             relative = self.accept(u, self.end, residual, history)
             s.held_steps += 1
             if relative <= opts.rtol:
                 s.phase = "done"
             pairs = self.setup.contact.active_pairs(u, self.end)
             self.keep(StepRecord("hold", self.end, pseudo, len(history), relative, pairs,
-                                 time.perf_counter() - clock))
+                                 time.perf_counter() - clock, converged))
             bar.set_postfix(held=s.held_steps, it=len(history), res=f"{relative:.1e}", pairs=pairs)
 
 
