@@ -13,34 +13,35 @@ r"""A whole-valve model for the implicit solver, built from an Abaqus input (Tex
   as tension-only cables (:class:`~skvalve.materials.uniaxial.TensionOnly`); chains of two-bar nodes
   are collapsed into one cable between branch points with the chain's path length as rest length and
   dangling bars are dropped (:mod:`.chordae`), so the implicit tangent has no zero-stiffness direction;
-* **conditions**: every ``*Boundary`` line of the chosen step (and of the model level) as a prescribed
-  displacement of mesh nodes, value times its amplitude at the step time (an amplitude-free condition
-  is held constant, Abaqus's default for dynamic steps, or ramped in a static step). A condition on a
-  shell node holds the whole fibre of extruded nodes through the thickness; rotational dofs and nodes
-  that are not part of the model (rigid clip surfaces, reference points) are skipped and noted;
-* **pressure**: each ``*Dsload`` ``P`` on an element-face surface as a follower pressure (load
-  stiffness included) on the corresponding mesh facets, magnitude times its amplitude;
+* **conditions**: every ``*Boundary`` line of the steps (and of the model level) as a prescribed displacement of
+  mesh nodes, following the multi-step history of :mod:`.history` (value times its amplitude in step time; an
+  amplitude-free condition is held constant in a dynamic step or ramped in a static one; carried into later steps
+  with its end value, or replaced). A condition on a shell node holds the whole fibre of extruded nodes through the
+  thickness; rotational dofs and nodes that are not part of the model are skipped and noted;
+* **pressure**: each ``*Dsload`` ``P`` on an element-face surface as a follower pressure (load stiffness included)
+  on the corresponding mesh facets, with its history over the steps;
 * **LINK MPCs** (the 1.0 annuloplasty ring): stiff penalty bars between the linked vertices, axial
   rigidity ``link_factor`` times the stiffest chord's, so a link's relative length change is its force over
-  that rigidity (:mod:`.links`); other ``*MPC`` types are refused with their file line.
+  that rigidity (:mod:`.links`); other ``*MPC`` types are refused with their file line;
+* **clip arms** (the 1.0 clip repair): rigid ``R3D4`` arms turned about their reference nodes as kinematic
+  obstacles (:mod:`.clip`), ``ValveModel.obstacles`` for the closure's IPC contact (:mod:`.setup`).
 
-The solver's load factor is the **step time** (0 to the step's time period): ``solve(problem,
-steps=times)``. Mesh vertices are numbered chordae-only nodes first, then the leaflet nodes, because
-scikit-fem counts ``max(cells) + 1`` vertices. Only one step is modelled at a time (``step=``); contact is the
-closure's business (issue 11). Inputs with parts the model cannot represent (the clip repair's rigid arms,
-connectors, bonded contact, further steps) are refused with their file lines (:mod:`.support`).
+The solver's load factor is the **total time** over all steps (0 to ``end_time``; a one-step input's step time):
+``solve(problem, steps=times)``; ``ValveModel.steps`` gives each step's name, start and period. ``step=k`` builds
+step ``k`` alone (its step time). Mesh vertices are numbered chordae-only nodes first, then the leaflet nodes,
+because scikit-fem counts ``max(cells) + 1`` vertices. Contact among the leaflets is the closure's business
+(issue 11). Inputs with parts the model cannot represent are refused with their file lines (:mod:`.support`).
 """
 
 from __future__ import annotations
 
-from collections import defaultdict
 from dataclasses import dataclass, field
 
 import numpy as np
 import skfem
 
-from ..fem.amplitudes import Amplitude, SmoothStep, Tabular
 from ..fem.constitutive import MaterialRegions
+from ..fem.contact.obstacles import Obstacle
 from ..fem.errors import TangledMeshError
 from ..fem.fbar import FBarTerm
 from ..fem.hyperelastic import HyperelasticTerm
@@ -52,7 +53,19 @@ from ..io.abaqus import HEX_FACE_NODES, AbaqusModel
 from ..materials import LeeSacks
 from ..materials.uniaxial import OgdenUniaxial, TensionOnly
 from .chordae import CollapsedChordae, collapse_chains, insertion_patches
+from .clip import ClipArm, clip_arms
 from .extrude import extrude_shell, hex_corner_jacobians
+from .history import (
+    NodalCondition,
+    PressureLoad,
+    StepWindow,
+    amplitude_table,
+    condition_histories,
+    load_histories,
+    nodal_conditions,
+    selected_steps,
+    step_windows,
+)
 from .links import LINK_FACTOR, Links, link_constraints, link_nodes
 from .support import check_supported
 
@@ -63,39 +76,6 @@ ABAQUS_TO_SKFEM_HEX = np.array([0, 4, 3, 1, 7, 5, 2, 6])
 _SHELL_TYPES = ("S4", "S4R", "S4R5")
 _BRICK_TYPES = ("C3D8", "C3D8R", "C3D8H", "C3D8RH", "C3D8I")
 _TRUSS_TYPES = ("T3D2", "T3D2H")
-
-
-@dataclass
-class NodalCondition:
-    """Component ``component`` (0..2) of ``vertices`` prescribed to ``value`` x amplitude(t)."""
-
-    vertices: np.ndarray
-    component: int
-    value: float
-    amplitude: Amplitude | None
-    ramp_time: float | None = None
-
-    def at(self, t: float) -> float:
-        """The prescribed value at step time ``t``."""
-        if self.amplitude is not None:
-            return self.value * float(self.amplitude(t))
-        if self.ramp_time is not None:
-            return self.value * min(max(t / self.ramp_time, 0.0), 1.0)
-        return self.value
-
-
-@dataclass
-class PressureLoad:
-    """Follower pressure ``magnitude`` x amplitude(t) on mesh ``facets`` (positive pushes into the surface)."""
-
-    surface: str
-    facets: np.ndarray
-    magnitude: float
-    amplitude: Amplitude | None
-    ramp_time: float | None = None
-
-    def at(self, t: float) -> float:
-        return NodalCondition(np.empty(0, int), 0, self.magnitude, self.amplitude, self.ramp_time).at(t)
 
 
 @dataclass
@@ -115,7 +95,8 @@ class Chordae:
 
 @dataclass
 class ValveModel:
-    """Leaflet hexes, chordae cables, nodal conditions and pressures on one mesh (module docstring)."""
+    """Leaflet hexes, chordae cables, nodal conditions and pressures on one mesh (module docstring); ``steps`` the
+    input's steps on the total-time axis, ``arms`` the rigid clip arms and ``obstacles`` their contact surfaces."""
 
     source: str
     mesh: skfem.MeshHex
@@ -130,6 +111,14 @@ class ValveModel:
     vertex_source: np.ndarray
     notes: list[str] = field(default_factory=list)
     links: Links | None = None
+    steps: list[StepWindow] = field(default_factory=list)
+    arms: list[ClipArm] = field(default_factory=list)
+    obstacles: list[Obstacle] = field(default_factory=list)
+
+    def step_index(self, t: float) -> int:
+        """The step that total time ``t`` falls in (a step's end belongs to it; 0 without steps)."""
+        starts = [w.start for w in self.steps]
+        return max(int(np.searchsorted(starts, t, side="left")) - 1, 0) if starts else 0
 
     def counts(self) -> dict[str, int]:
         """Sizes: hexes, vertices, cables, collapsed chain nodes, dropped bars, conditions, pressure facets."""
@@ -161,7 +150,7 @@ class ValveModel:
         chordae = Chordae(new[ch.ends[inside]], ch.rest_length[inside], ch.area[inside], ch.law_index[inside],
                           ch.laws, ch.law_names, ch.reduction, ch.slack_stretch[inside])
         conditions = [NodalCondition(new[c.vertices[new[c.vertices] >= 0]], c.component, c.value, c.amplitude,
-                                     c.ramp_time) for c in self.conditions]
+                                     c.ramp_time, c.history) for c in self.conditions]
         conditions = [c for c in conditions if c.vertices.size]
         lookup = _facet_lookup(mesh)
         pressures = []
@@ -171,12 +160,14 @@ class ValveModel:
             facets = [lookup.get(tuple(sorted(col))) for col in corners[:, mine].T.tolist()]
             facets = np.array([f for f in facets if f is not None], dtype=np.int64)
             if facets.size:
-                pressures.append(PressureLoad(load.surface, facets, load.magnitude, load.amplitude, load.ramp_time))
+                pressures.append(PressureLoad(load.surface, facets, load.magnitude, load.amplitude, load.ramp_time,
+                                              load.history))
         names = ", ".join(self.region_names[r] for r in regions)
         return ValveModel(self.source, mesh, self.element_source[keep], self.regions[keep], self.region_names,
                           self.laws, chordae, conditions, pressures, self.end_time, self.vertex_source[used],
                           self.notes + [f"submodel of {names}: {int(inside.sum())} of {inside.size} cables kept"],
-                          self.links.subset(new) if self.links is not None else None)
+                          self.links.subset(new) if self.links is not None else None, self.steps, self.arms,
+                          self.obstacles)
 
     def _holding_chordae_nodes(self, leaflet_vertices: np.ndarray) -> np.ndarray:
         """The nodes of no hex on the chordae that reach ``leaflet_vertices``: cables whose ends are leaflet vertices
@@ -203,7 +194,7 @@ class ValveModel:
 
     def problem(self, solid: str = "fbar", slack_fraction: float = 1e-6, transition: float = 0.01,
                 insertion: str = "node", compression: bool = False) -> Problem:
-        """A :class:`~skvalve.fem.Problem` of the model (load factor = step time).
+        """A :class:`~skvalve.fem.Problem` of the model (load factor = total time).
 
         ``solid``: ``"fbar"`` (F-bar mean-dilatation hexes, default) or ``"q1"`` (full integration, locks).
         ``slack_fraction``: slack stiffness of the cables relative to their small-strain modulus. The default
@@ -259,19 +250,6 @@ class _ValueAt:
         return np.asarray(self.condition.at(t))
 
 
-def _amplitudes(abaqus: AbaqusModel) -> dict[str, Amplitude]:
-    out: dict[str, Amplitude] = {}
-    for key, amp in abaqus.amplitudes.items():
-        kind = amp.definition.upper()
-        if kind == "SMOOTH STEP":
-            out[key.upper()] = SmoothStep(tuple(amp.times), tuple(amp.values), name=amp.name)
-        elif kind == "TABULAR":
-            out[key.upper()] = Tabular(tuple(amp.times), tuple(amp.values), name=amp.name)
-        else:
-            raise ValueError(f"{amp.location}: amplitude {amp.name!r} has unsupported definition {amp.definition!r}")
-    return out
-
-
 def _leaflet_law(abaqus: AbaqusModel, name: str) -> LeeSacks:
     material = abaqus.material(name)
     data = material.option("anisotropic hyperelastic").data
@@ -292,16 +270,23 @@ def _chord_law(abaqus: AbaqusModel, name: str) -> OgdenUniaxial:
     return OgdenUniaxial(tuple(data[0:2 * n:2]), tuple(data[1:2 * n:2]))
 
 
-def valve_model(abaqus: AbaqusModel, layers: int = 4, step: int = 0, link_factor: float = LINK_FACTOR,
+def valve_model(abaqus: AbaqusModel, layers: int = 4, step: int | None = None, link_factor: float = LINK_FACTOR,
                 partial: bool = False) -> ValveModel:
-    """Build the :class:`ValveModel` of step ``step`` of ``abaqus`` (shells extruded into ``layers`` hexes; LINK
-    MPCs with ``link_factor`` times the stiffest chord's axial rigidity).
+    """Build the :class:`ValveModel` of ``abaqus`` over all its steps (``step`` None; load factor = total time) or of
+    step ``step`` alone (load factor = its step time); shells extruded into ``layers`` hexes; LINK MPCs with
+    ``link_factor`` times the stiffest chord's axial rigidity.
 
     Raises :class:`~skvalve.valve.support.UnsupportedInputError` naming the keywords and file lines the model
-    cannot represent (rigid bodies, connectors, rigid-surface or bonded contact, rotations, further steps: the
-    1.0 clip repair); ``partial=True`` builds step ``step`` alone if it uses none of them itself.
+    cannot represent (:mod:`.support`); ``partial=True`` builds step ``step`` (default the first) alone if it uses
+    none of them itself.
     """
+    if partial and step is None:
+        step = 0
     notes: list[str] = check_supported(abaqus, step, partial)
+    steps = selected_steps(abaqus, step)
+    windows = step_windows(steps)
+    amplitudes, total_time = amplitude_table(abaqus)
+    histories = condition_histories(abaqus, steps, windows, amplitudes, total_time)
     elem_type = np.empty(abaqus.n_elements, dtype=object)
     elem_conn: dict[int, np.ndarray] = {}
     for block in abaqus.element_blocks:
@@ -357,8 +342,7 @@ def valve_model(abaqus: AbaqusModel, layers: int = 4, step: int = 0, link_factor
         law_names.append(section.material)
     bars_arr = np.vstack(bars) if bars else np.zeros((0, 2), dtype=np.int64)
     group_arr = np.concatenate(bar_group) if bar_group else np.zeros(0, dtype=np.int64)
-    step_obj = abaqus.steps[step] if abaqus.steps else None
-    bcs = list(abaqus.boundary_conditions) + (list(step_obj.boundary_conditions) if step_obj else [])
+    bcs = list(abaqus.boundary_conditions) + [bc for s in steps for bc in s.boundary_conditions]
     bc_nodes = np.unique(np.concatenate([bc.nodes for bc in bcs])) if bcs else np.zeros(0, dtype=np.int64)
     linked = link_nodes(abaqus)
     anchored = np.union1d(np.union1d(np.fromiter(solid_vertex_of.keys(), dtype=np.int64), bc_nodes), linked)
@@ -392,55 +376,41 @@ def valve_model(abaqus: AbaqusModel, layers: int = 4, step: int = 0, link_factor
         notes.append(f"{links.size} LINK MPC(s) as penalty bars, EA = {links.rigidity:.4g} N ({link_factor:g} x the "
                      "stiffest chord's)")
 
-    # ---------------------------------------------------------------- conditions and pressure
-    amplitudes = _amplitudes(abaqus)
-    static = step_obj is not None and (step_obj.procedure or "").lower().startswith("static")
-    end_time = step_obj.time_period if step_obj else 1.0
-    ramp = end_time if static else None
-    grouped: dict[tuple, list[int]] = defaultdict(list)
-    skipped_nodes, skipped_rotations = set(), 0
-    for bc in bcs:
-        if bc.amplitude is not None and bc.amplitude.upper() not in amplitudes:
-            raise ValueError(f"{bc.location}: boundary condition uses unknown amplitude {bc.amplitude!r}")
-        for dof in range(bc.first_dof, bc.last_dof + 1):
-            if dof > 3:
-                skipped_rotations += 1
-                continue
-            for g in bc.nodes:
-                if int(g) not in fibres:
-                    skipped_nodes.add(int(g))
-                    continue
-                grouped[(dof - 1, float(bc.value), bc.amplitude)].extend(fibres[int(g)])
-    # later definitions of the same dof win: keep each (vertex, component) in its last group only
-    owner: dict[tuple[int, int], tuple] = {}
-    for key, verts in grouped.items():
-        for v in verts:
-            owner[(v, key[0])] = key
-    final: dict[tuple, list[int]] = defaultdict(list)
-    for (v, _), key in owner.items():
-        final[key].append(v)
-    conditions = [NodalCondition(np.unique(np.asarray(v, dtype=np.int64)), key[0], key[1],
-                                 amplitudes[key[2].upper()] if key[2] else None, ramp) for key, v in final.items()]
+    # ---------------------------------------------------------------- clip arms, conditions and pressure
+    arms = clip_arms(abaqus, histories)
+    for arm in arms:
+        end = arm.angle.at(windows[-1].end)
+        notes.append(f"clip arm {arm.name}: {arm.triangles.shape[0]} triangles turning about reference node "
+                     f"{int(abaqus.node_labels[arm.reference_node])}, axis {np.round(arm.axis, 6).tolist()}, by "
+                     f"{end:.6g} rad ({np.degrees(end):.4g} deg) at the end")
+    references = {arm.reference_node for arm in arms}
+    end_time = windows[-1].end
+    ramp = windows[0].period if len(windows) == 1 and windows[0].static else None
+    conditions, skipped_nodes, skipped_rotations = nodal_conditions(bcs, histories, fibres, references, ramp)
     if skipped_nodes:
         notes.append(f"{len(skipped_nodes)} constrained node(s) outside the model skipped (e.g. labels "
                      f"{abaqus.node_labels[sorted(skipped_nodes)][:5].tolist()})")
     if skipped_rotations:
         notes.append(f"{skipped_rotations} rotational boundary dof(s) skipped (no rotations on solids)")
     pressures = []
-    if step_obj is not None:
+    if steps:
         facet_index = _facet_lookup(mesh)
-        for load in step_obj.distributed_loads:
+        for load, history in load_histories(steps, windows, amplitudes, total_time):
             if load.load_type.upper() != "P":
                 notes.append(f"*Dsload type {load.load_type} on {load.surface} skipped (only P is modelled)")
                 continue
             facets = _surface_facets(abaqus.surface(load.surface), elem_conn, vertex_of, facet_index,
                                      ext, offset, shell_sources)
-            pressures.append(PressureLoad(load.surface, facets, load.magnitude,
-                                          amplitudes[load.amplitude.upper()] if load.amplitude else None, ramp))
-    if step_obj is not None and len(abaqus.steps) > 1:
-        notes.append(f"only step {step} ({step_obj.name!r}) modelled; {len(abaqus.steps) - 1} other step(s) not")
+            defining = [seg for seg in history.segments if seg.location is not None]
+            peak = max(defining, key=lambda seg: abs(seg.value))
+            pressures.append(PressureLoad(load.surface, facets, peak.value, defining[0].amplitude, ramp, history))
+    if step is not None and len(abaqus.steps) > 1:
+        notes.append(f"only step {step} ({steps[0].name!r}) modelled; {len(abaqus.steps) - 1} other step(s) not")
+    elif len(windows) > 1:
+        notes.append("steps on the total-time axis: " + ", ".join(f"{w.name!r} {w.start:g}-{w.end:g}"
+                                                                   for w in windows))
     return ValveModel(str(abaqus.path), mesh, sources, regions, region_names, laws, chordae, conditions, pressures,
-                      end_time, vertex_source, notes, links)
+                      end_time, vertex_source, notes, links, windows, arms, [arm.obstacle() for arm in arms])
 
 
 def _facet_lookup(mesh: skfem.MeshHex) -> dict[tuple[int, ...], int]:

@@ -2,8 +2,8 @@
 
 :func:`valve_setup` builds what :func:`skvalve.valve.run.close_valve` solves and what the outputs
 (:mod:`.outputs`, the mathur2022 figures) measure: the :class:`~skvalve.valve.model.ValveModel`, its
-:class:`~skvalve.fem.problem.Problem` with an :class:`~skvalve.fem.contact.IPCContact` term, each vertex's leaflet and
-the lumped nodal volumes that weight the pseudo-mass.
+:class:`~skvalve.fem.problem.Problem` with an :class:`~skvalve.fem.contact.IPCContact` term (with the model's clip arms
+as moving obstacles, :mod:`.clip`), each vertex's leaflet and the lumped nodal volumes that weight the pseudo-mass.
 """
 
 from __future__ import annotations
@@ -54,8 +54,8 @@ def valve_setup(source: str | Path | AbaqusModel, options: CloseOptions | None =
     c = options.contact
     stiffness = stiffness_for_pressure(c.pressure_factor * peak, c.dhat, 0.5)
     contact = problem.add_term(IPCContact(problem.space, dhat=c.dhat, stiffness=stiffness,
-                                          exclude_within=c.exclude_within, friction=c.friction,
-                                          check_intersections=c.check_intersections))
+                                          obstacles=model.obstacles, exclude_within=c.exclude_within,
+                                          friction=c.friction, check_intersections=c.check_intersections))
     leaflet = np.full(model.mesh.p.shape[1], -1, dtype=np.int64)
     leaflet[model.mesh.t] = model.regions[None, :]
     volumes = lumped_volume(problem.space)

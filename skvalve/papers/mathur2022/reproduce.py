@@ -16,8 +16,10 @@ residual recomputed, and the rows of that input's column printed (:mod:`.columns
 ``full=True`` (``--full``): every Texas TriValve input present is closed by :func:`~skvalve.valve.run.close_valve`
 in ``out/<key>`` (``1.0-diseased``, ``1.1-healthy``, ...: the 1.0 and 1.1 diseased inputs share a file name), resumed
 from the state kept there, so an interrupted ``--full`` goes on where it stopped; each input's run summary (wall
-time, steps, iterations, residual, intersection, smallest Jacobian), figures and rows follow it. The clip input is
-refused by the valve model (rigid clip arms are not modelled): its column is reported as not computed.
+time, steps, iterations, residual, intersection, smallest Jacobian), figures and rows follow it. The clip input runs
+its three steps in total time (0-2.5) with its four rigid arms as moving IPC obstacles (:mod:`skvalve.valve.clip`);
+its rough, no-separation arm contact is the frictionless barrier there (the model's notes say so). An input the
+model cannot represent is reported as not computed, with the keywords it refuses.
 
 The model files (Mathur et al. 2022, CC BY-NC-SA 4.0; Texas TriValve 1.1, CC BY 4.0) are never copied; without them
 the run ends with a message and exit code 2 (``$SKVALVE_TRIVALVE`` names the 1.0 diseased .inp file or its folder).
@@ -161,10 +163,8 @@ def _close_one(key: str, path: Path, out: Path | None) -> Iterator[Row | Stage |
     try:
         setup = valve_setup(path, options)
     except UnsupportedInputError as err:
-        what = (" (the clip repair's rigid clip arms, their capture steps and connectors)" if column.state == "clip"
-                else "")
         yield Stage(f"{key} ({path.name}): the paper's {column.state} column is not computed: the valve model does "
-                    f"not represent {len(err.features)} keyword(s) of the input{what}; first: {err.features[0]}")
+                    f"not represent {len(err.features)} keyword(s) of the input; first: {err.features[0]}")
         return
     if kept is not None and kept.u.size != setup.problem.space.n_dofs:
         raise InputError(f"kept state {folder / STATE_FILE}: {kept.u.size} displacement values for the "
