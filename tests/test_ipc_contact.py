@@ -2,6 +2,8 @@
 in closed form, blocks and sheets pressed together and onto rigid surfaces without an intersection at any accepted
 state, and a block that passes straight through an obstacle once the solvers' collision-free cap is removed."""
 
+import dataclasses
+
 import ipctk
 import numpy as np
 import pytest
@@ -242,6 +244,31 @@ def test_an_obstacles_motion_enters_the_collision_free_step():
     fraction = contact.step_fraction(u, 0.0, u, 1.0)
     assert 0.5 * 0.3 < fraction < 0.3
     assert contact.positions(u, 1.0)[contact.n_body:, 2] == pytest.approx(np.full(4, 0.07))
+
+
+def test_an_obstacle_joins_the_contact_at_its_active_from():
+    """A sheet through the middle of a block, active from load factor 1: before, it is no part of the collision mesh
+    (no intersection, no energy, no pairs), a move into its activation while the block overlaps it is refused naming
+    it, and once the block is lifted clear the sheet repels it and caps a move back down."""
+    mesh = box((2, 2, 1), (1.0, 1.0, 0.4))
+    space = Space(mesh)
+    sheet = dataclasses.replace(Obstacle.rectangle([0.5, 0.5, 0.2], [0, 0, 1], 2.0, name="arm"), active_from=1.0)
+    contact = IPCContact(space, dhat=0.01, stiffness=20.0, obstacles=[sheet])
+    u = np.zeros(space.n_dofs)
+    assert not contact.intersects(u, 0.5) and contact.energy(u, 0.5) == 0.0 and contact.active_pairs(u, 0.5) == 0
+    assert contact.intersects(u, 1.0)
+    with pytest.raises(IntersectionError, match="arm join the contact by load factor 1 while the body overlaps"):
+        contact.step_fraction(u, 0.5, u, 1.0)
+    lifted = u.copy()
+    lifted[2::3] = 0.205  # the block's base 0.005 above the sheet, within dhat
+    assert contact.step_fraction(lifted, 0.5, lifted, 1.0) == 1.0
+    assert contact.energy(lifted, 0.5) == 0.0 and contact.energy(lifted, 1.0) > 0.0
+    force = contact.assemble(lifted, 1.0, False, None).internal[2::3]
+    base = mesh.p[2] == 0.0
+    assert np.all(force[base] < 0.0) and np.all(force[~base] == 0.0)  # lifting the base lowers the barrier
+    lowered = lifted.copy()
+    lowered[2::3] = 0.195
+    assert contact.step_fraction(lifted, 1.0, lowered, 1.0) < 0.5
 
 
 def test_bad_input_is_named():

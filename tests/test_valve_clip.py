@@ -203,6 +203,20 @@ def test_the_clip_input_is_accepted_with_its_approximations_noted(clip):
     assert any(":75482: Rough_Interaction" in n and "frictionless IPC barrier" in n for n in notes)
     assert all(n in model.notes for n in notes)
     assert sum(n.startswith("clip arm ") for n in model.notes) == 4
+    assert any(n.startswith("clip arms in contact from") for n in model.notes)
+
+
+def test_the_arms_join_the_contact_when_they_start_to_turn(clip):
+    """Contact with each arm starts at 1.5, the start of "Clip close" where its angle starts to change (the leaflets
+    closed in step 1 overlap the parked arms): before, the collision mesh is the leaflets' alone."""
+    abaqus, model = clip
+    starts = {w.name: w.start for w in model.steps}
+    assert [o.active_from for o in model.obstacles] == [starts["Clip close"]] * 4
+    assert all(arm.angle.at(starts["Clip close"]) == 0.0 != arm.angle.at(model.end_time) for arm in model.arms)
+    setup = valve_setup(abaqus, model=model)
+    u = np.zeros(setup.problem.space.n_dofs)
+    assert setup.contact.positions(u, 1.49).shape[0] == setup.contact.n_body
+    assert setup.contact.positions(u, 1.5).shape[0] == setup.contact.rest.shape[0]
     assert not any("rotational boundary" in n or "outside the model" in n for n in model.notes)
 
 

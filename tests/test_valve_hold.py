@@ -17,10 +17,12 @@ from skvalve.fem.meshes import box
 from skvalve.fem.newton import solve
 from skvalve.materials import NeoHookean
 from skvalve.valve import run as run_module
+from skvalve.valve.history import StepWindow
 from skvalve.valve.options import CloseOptions, HoldOptions, StepOptions
 from skvalve.valve.setup import ValveSetup, end_load_norm
 
 PRESSURE = 0.05
+CAP = 1  # iterations of a damped held step in the test of unconverged held steps
 
 
 def _block() -> ValveSetup:
@@ -55,6 +57,9 @@ def test_damped_held_steps_alone_reach_the_static_equilibrium(monkeypatch):
     assert report.converged and report.relative_residual <= 1e-6
     held = [record for record in report.records if record.phase == "hold"]
     assert held and all(record.iterations > 0 for record in held)  # every held step moved
+    assert all(record.converged for record in held) and report.failed_steps == 0
+    for before, after in zip(held, held[1:], strict=False):  # each converged held step doubles the pseudo-step
+        assert after.increment == pytest.approx(options.hold.growth * before.increment)
     residuals = [record.relative_residual for record in held]
     assert all(b < a for a, b in zip(residuals, residuals[1:], strict=False))
     # a failed static problem is tried again only once the residual fell tenfold, not from every held state
@@ -66,23 +71,41 @@ def test_damped_held_steps_alone_reach_the_static_equilibrium(monkeypatch):
     np.testing.assert_allclose(report.u, newton.u(), atol=1e-5 * np.abs(newton.u()).max())
 
 
-def test_held_steps_out_of_iterations_are_kept_for_their_progress():
+def test_held_steps_out_of_iterations_are_kept_for_their_progress(monkeypatch):
     """A held step that runs out of iterations is kept (marked unconverged) when its last iterate lowered the static
-    residual, and only a converged held step lets the pseudo-step grow: with max_iter 2 the held steps on the block
-    end unconverged and still reach the equilibrium, the static residual falling at every held step."""
-    options = CloseOptions(steps=StepOptions(first=0.25, largest=0.25, damping=1.0, max_iter=2),
-                           hold=HoldOptions(max_steps=200))
+    residual, and keeps its pseudo-step: with the damped held steps held to one iteration on the block, every one ends
+    unconverged, and the held steps still reach the equilibrium, the static residual falling at every held step."""
+    step = run_module._Run.step
+
+    def capped(self, t_new, inertia_scale, rtol, max_iter):
+        damped_hold = self.state.phase == "hold" and inertia_scale > 0.0
+        return step(self, t_new, inertia_scale, rtol, CAP if damped_hold else max_iter)
+
+    monkeypatch.setattr(run_module._Run, "step", capped)
+    options = CloseOptions(steps=StepOptions(first=0.25, largest=0.25, damping=1.0), hold=HoldOptions(max_steps=200))
     report = run_module.close_valve(None, options, setup=_block(), progress=False)
     assert report.converged and report.relative_residual <= 1e-6
     held = [record for record in report.records if record.phase == "hold" and np.isfinite(record.increment)]
-    assert any(not record.converged for record in held) and any(record.converged for record in held)
+    assert len(held) > 1 and not any(record.converged for record in held)
+    assert all(record.iterations == CAP and "unconverged" in record.line() for record in held)
+    assert len({record.increment for record in held}) == 1  # an unconverged step does not let the pseudo-mass fade
     residuals = [record.relative_residual for record in report.records if record.phase == "hold"]
     assert all(b < a for a, b in zip(residuals, residuals[1:], strict=False))
-    for before, after in zip(held, held[1:], strict=False):  # grows by HoldOptions.growth after a converged step
-        expected = before.increment * (options.hold.growth if before.converged else 1.0)
-        assert after.increment == pytest.approx(expected)
-    assert all(record.iterations == 2 for record in held if not record.converged)
-    assert "unconverged" in held[[record.converged for record in held].index(False)].line()
+
+
+def test_path_steps_land_on_the_inputs_step_boundaries():
+    """A model with steps breaking at total time 0.37: a path step lands there exactly (amplitudes and obstacle
+    contact change at step boundaries), and the step after it keeps the planned length the break cut short."""
+    setup = _block()
+    setup.model.steps = [StepWindow("first", 0.0, 0.37, False), StepWindow("second", 0.37, 0.63, False)]
+    options = CloseOptions(steps=StepOptions(first=0.25, largest=0.25, damping=1.0))
+    report = run_module.close_valve(None, options, setup=setup, progress=False)
+    path = [record for record in report.records if record.phase == "path"]
+    times = [record.t for record in path]
+    assert 0.37 in times and report.converged
+    k = times.index(0.37)
+    assert path[k].increment == pytest.approx(0.37 - times[k - 1]) and path[k].increment < 0.25
+    assert path[k + 1].increment == pytest.approx(min(1.0 - 0.37, 0.25))
 
 
 def test_end_load_norm_is_the_pressure_nodal_forces_norm():

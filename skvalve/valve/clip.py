@@ -39,7 +39,7 @@ import numpy as np
 
 from ..fem.contact.obstacles import Obstacle
 from ..io.abaqus import AbaqusModel, Location, Transform
-from .history import History
+from .history import History, StepWindow
 
 __all__ = ["ClipArm", "ClipIssue", "rodrigues", "transform_axes", "rigid_body_issues", "connector_issues",
            "clip_arms", "INERT_CONNECTIONS"]
@@ -104,9 +104,18 @@ class ClipArm:
         """Vertex positions (n, 3) at total time ``t``."""
         return self.centre + (self.vertices - self.centre) @ self.rotation(t).T
 
-    def obstacle(self) -> Obstacle:
-        """The arm as an :class:`Obstacle` turning about its reference node, no translation."""
-        return Obstacle.rigid(self.vertices, self.triangles, _no_translation, self.rotation, self.centre, self.name)
+    def turns_from(self, windows: list[StepWindow]) -> float:
+        """The start (total time) of the first step in which the arm turns; the last step's end if it never does."""
+        for window in windows:
+            if self.angle.at(window.start) != self.angle.at(window.end):
+                return window.start
+        return windows[-1].end
+
+    def obstacle(self, active_from: float = 0.0) -> Obstacle:
+        """The arm as an :class:`Obstacle` turning about its reference node, no translation, in contact from total
+        time ``active_from``."""
+        return Obstacle.rigid(self.vertices, self.triangles, _no_translation, self.rotation, self.centre, self.name,
+                              active_from)
 
 
 def _no_translation(t: float) -> np.ndarray:

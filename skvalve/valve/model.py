@@ -383,6 +383,14 @@ def valve_model(abaqus: AbaqusModel, layers: int = 4, step: int | None = None, l
         notes.append(f"clip arm {arm.name}: {arm.triangles.shape[0]} triangles turning about reference node "
                      f"{int(abaqus.node_labels[arm.reference_node])}, axis {np.round(arm.axis, 6).tolist()}, by "
                      f"{end:.6g} rad ({np.degrees(end):.4g} deg) at the end")
+    # contact with an arm starts when it starts to turn (the clip repair: the start of "Clip close", 1.5), not
+    # with the input's contact pairs ("Clip capture", 1.0): the leaflets closed by step 1 overlap three of the four
+    # parked arms (a state the barrier cannot start from); the capture step's released pressure reopens them first
+    obstacles = [arm.obstacle(arm.turns_from(windows)) for arm in arms]
+    if arms:
+        starts = ", ".join(f"{arm.name} {o.active_from:g}" for arm, o in zip(arms, obstacles, strict=True))
+        notes.append(f"clip arms in contact from the total time each starts to turn ({starts}); the input's contact "
+                     "pairs start a step earlier, while the leaflets closed in step 1 overlap the parked arms")
     references = {arm.reference_node for arm in arms}
     end_time = windows[-1].end
     ramp = windows[0].period if len(windows) == 1 and windows[0].static else None
@@ -410,7 +418,7 @@ def valve_model(abaqus: AbaqusModel, layers: int = 4, step: int | None = None, l
         notes.append("steps on the total-time axis: " + ", ".join(f"{w.name!r} {w.start:g}-{w.end:g}"
                                                                    for w in windows))
     return ValveModel(str(abaqus.path), mesh, sources, regions, region_names, laws, chordae, conditions, pressures,
-                      end_time, vertex_source, notes, links, windows, arms, [arm.obstacle() for arm in arms])
+                      end_time, vertex_source, notes, links, windows, arms, obstacles)
 
 
 def _facet_lookup(mesh: skfem.MeshHex) -> dict[tuple[int, ...], int]:

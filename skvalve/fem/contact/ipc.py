@@ -65,6 +65,7 @@ from scipy.spatial import cKDTree
 from ..errors import SolverError
 from ..space import Space
 from ..terms import Contribution, Term
+from .activation import CollisionPhase, CollisionPhases
 from .obstacles import Obstacle, Plane
 from .plane_barrier import PlaneBarrier
 from .surface import ContactSurface
@@ -181,21 +182,22 @@ class IPCContact(Term):
             self._obstacle_rows.append(slice(offset, offset + obstacle.vertices.shape[0]))
             offset += obstacle.vertices.shape[0]
         triangles = np.ascontiguousarray(np.concatenate(faces), dtype=np.int32)
-        edges = ipctk.edges(triangles)
         self.rest = np.ascontiguousarray(np.concatenate(rest))
-        self.mesh = ipctk.CollisionMesh(self.rest, edges, triangles)
-        self.mesh.can_collide = self._filter(exclude_within, self_contact)
+        whole = ipctk.CollisionMesh(self.rest, ipctk.edges(triangles), triangles)  # every obstacle: areas, extent
         self.diagonal = float(ipctk.world_bbox_diagonal_length(self.rest))
         self.barrier = ipctk.BarrierPotential(self.dhat, self.stiffness, True)
         self.collisions = ipctk.NormalCollisions()
         self.collisions.use_area_weighting = True
-        self._built_for: np.ndarray | None = None
+        self._built_for: tuple[tuple[bool, ...], np.ndarray] | None = None
         self.area = np.zeros(space.n_scalar)  # the barrier's area weights: a third of each adjacent triangle
-        self.area[self.nodes] = np.asarray(self.mesh.vertex_areas)[: self.n_body]
+        self.area[self.nodes] = np.asarray(whole.vertex_areas)[: self.n_body]
         self._planes = PlaneBarrier(self.planes, self.area[self.nodes], self.dhat) if self.planes else None
         rows = (3 * self.nodes[:, None] + np.arange(3)).ravel()
-        self._select = sp.csr_matrix((np.ones(rows.size), (rows, np.arange(rows.size))),
-                                     shape=(space.n_dofs, 3 * self.rest.shape[0]))
+        select = sp.csr_matrix((np.ones(rows.size), (rows, np.arange(rows.size))),
+                               shape=(space.n_dofs, 3 * self.rest.shape[0]))
+        self._phases = CollisionPhases(self.rest, self.n_body, faces[0], self.obstacles, self._obstacle_rows,
+                                       self._body_filter(exclude_within, self_contact), self_contact, select)
+        self._enter(0.0)
         self._friction_potential = None if friction is None else ipctk.FrictionPotential(friction.slip)
         self._tangential = None
         self._lagged = self.rest.copy()
@@ -211,37 +213,41 @@ class IPCContact(Term):
                                     "and the obstacles' positions at load factor 0)")
 
     # ------------------------------------------------------------------ set-up
-    def _filter(self, exclude_within: float, self_contact: bool) -> ipctk.CollisionFilter:
-        """Obstacle vertices never collide with each other; body vertices closer than ``exclude_within`` in the
-        reference (and all body pairs without self-contact) neither."""
-        patches = np.arange(self.rest.shape[0], dtype=np.int32)
-        patches[self.n_body:] = self.n_body  # every obstacle vertex in one patch: no obstacle-obstacle pairs
-        if not self_contact:
-            patches[: self.n_body] = -1
-        allowed = ipctk.make_vertex_patches_filter(patches)
-        if exclude_within > 0.0 and self_contact:
-            pairs = cKDTree(self.rest[: self.n_body]).query_pairs(exclude_within, output_type="ndarray")
-            explicit = {(int(min(a, b)), int(max(a, b))): False for a, b in pairs}
-            allowed = allowed & ipctk.make_sparse_filter(explicit, True)
-        return allowed
+    def _body_filter(self, exclude_within: float, self_contact: bool) -> ipctk.CollisionFilter | None:
+        """Body vertices closer than ``exclude_within`` in the reference never collide (obstacle vertices never
+        collide with each other, nor, without ``self_contact``, body vertices: :mod:`.activation`)."""
+        if not (exclude_within > 0.0 and self_contact):
+            return None
+        pairs = cKDTree(self.rest[: self.n_body]).query_pairs(exclude_within, output_type="ndarray")
+        return ipctk.make_sparse_filter({(int(min(a, b)), int(max(a, b))): False for a, b in pairs}, True)
+
+    def _enter(self, t: float) -> CollisionPhase:
+        """Make the phase at load factor ``t`` (the obstacles active then) the current collision mesh."""
+        phase = self._phases.at(t)
+        self.mesh, self._select, self._phase = phase.mesh, phase.select, phase
+        return phase
 
     def _collisions_at(self, V: np.ndarray) -> ipctk.NormalCollisions:
         """The collision set at positions ``V``, built once per state (assembly, energy and output share it)."""
-        if self._built_for is None or not np.array_equal(self._built_for, V):
+        key = self._phase.key
+        if self._built_for is None or self._built_for[0] != key or not np.array_equal(self._built_for[1], V):
             self.collisions.build(self.mesh, V, self.dhat)
-            self._built_for = V.copy()
+            self._built_for = (key, V.copy())
         return self.collisions
 
     def forget_collisions(self) -> None:
         """Drop the collision set kept for the last state (the next evaluation builds it again)."""
         self._built_for = None
 
-    def positions(self, u: np.ndarray, t: float) -> np.ndarray:
-        """Collision-mesh vertex positions (n, 3): the body's surface at ``u``, the obstacles at ``t``."""
-        V = self.rest.copy()
+    def positions(self, u: np.ndarray, t: float, phase_at: float | None = None) -> np.ndarray:
+        """Collision-mesh vertex positions (n, 3): the body's surface at ``u``, the obstacles active at load factor
+        ``phase_at`` (default ``t``; that phase becomes the current mesh) where they are at ``t``."""
+        phase = self._enter(t if phase_at is None else phase_at)
+        V = self.rest[phase.rows]
         V[: self.n_body] += u[: self.space.n_u].reshape(-1, 3)[self.nodes]
-        for obstacle, rows in zip(self.obstacles, self._obstacle_rows, strict=True):
-            V[rows] = obstacle.at(t)
+        for obstacle, rows in zip(self.obstacles, phase.slices, strict=True):
+            if rows is not None:
+                V[rows] = obstacle.at(t)
         return V
 
     def suggest_stiffness(self, elastic_gradient: np.ndarray, u: np.ndarray, t: float,
@@ -271,7 +277,7 @@ class IPCContact(Term):
             grad = grad + plane_grad
             if tangent:
                 H, Hp = H + plane_H, Hp + plane_Hp
-        if self._tangential is not None and len(self._tangential):
+        if self._tangential is not None and len(self._tangential) and self._lagged.shape == V.shape:
             slip = V - self._lagged
             grad = grad + self._friction_potential.gradient(self._tangential, self.mesh, slip)
             if tangent:
@@ -295,7 +301,7 @@ class IPCContact(Term):
         value = float(self.barrier(self.collisions, self.mesh, V))
         if self._planes is not None:
             value += self._planes.energy(V, self.stiffness)
-        if self._tangential is not None and len(self._tangential):
+        if self._tangential is not None and len(self._tangential) and self._lagged.shape == V.shape:
             value += float(self._friction_potential(self._tangential, self.mesh, V - self._lagged))
         return value
 
@@ -322,7 +328,13 @@ class IPCContact(Term):
     def step_fraction(self, u0: np.ndarray, t0: float, u1: np.ndarray, t1: float) -> float:
         """0.9 of the collision-free share of the straight move (ipctk ``compute_collision_free_stepsize``), 1 when
         the whole move is free."""
-        V0, V1 = self.positions(u0, t0), self.positions(u1, t1)
+        V0 = self.positions(u0, t0, phase_at=t1)  # the obstacles active at the end of the move, from its start
+        if self._phases.key(t0) != self._phase.key and ipctk.has_intersections(self.mesh, V0):
+            joining = [o.name for o, was, now in zip(self.obstacles, self._phases.key(t0), self._phase.key,
+                                                     strict=True) if now and not was]
+            raise IntersectionError(f"ipc contact: obstacle(s) {', '.join(joining)} join the contact by load factor "
+                                    f"{t1:.6g} while the body overlaps them (at {t0:.6g})")
+        V1 = self.positions(u1, t1)
         fraction = float(ipctk.compute_collision_free_stepsize(self.mesh, V0, V1))
         if self._planes is not None:
             fraction = min(fraction, self._planes.step_fraction(V0, V1))

@@ -27,12 +27,16 @@ class Obstacle:
     triangles : (m, 3) vertex indices; the side the body is on does not matter (the barrier acts on distances).
     motion : ``t -> (n, 3)`` displacement of the vertices at load factor ``t`` (``None``: fixed).
     name : shown in error messages.
+    active_from : load factor from which the body collides with it; before, the body may overlap it (a clip arm
+        parked where the leaflets close, in contact only once they have reopened). At ``active_from`` the body must
+        be clear of it (:class:`~skvalve.fem.contact.ipc.IPCContact` refuses an intersecting state).
     """
 
     vertices: np.ndarray
     triangles: np.ndarray
     motion: Callable[[float], np.ndarray] | None = None
     name: str = "obstacle"
+    active_from: float = 0.0
 
     def __post_init__(self) -> None:
         self.vertices = np.array(self.vertices, dtype=float)
@@ -44,6 +48,8 @@ class Obstacle:
         if self.triangles.ndim != 2 or self.triangles.shape[1] != 3 or self.triangles.shape[0] == 0:
             raise ValueError(f"obstacle {self.name!r}: triangles must have shape (m > 0, 3); got "
                              f"{self.triangles.shape}")
+        if not np.isfinite(self.active_from):
+            raise ValueError(f"obstacle {self.name!r}: active_from must be finite; got {self.active_from!r}")
         if self.triangles.min() < 0 or self.triangles.max() >= self.vertices.shape[0]:
             raise ValueError(f"obstacle {self.name!r}: triangle vertex indices must lie in "
                              f"0..{self.vertices.shape[0] - 1}")
@@ -63,7 +69,7 @@ class Obstacle:
     @classmethod
     def rigid(cls, vertices: np.ndarray, triangles: np.ndarray, translation: Callable[[float], np.ndarray],
               rotation: Callable[[float], np.ndarray] | None = None, centre: np.ndarray | None = None,
-              name: str = "obstacle") -> Obstacle:
+              name: str = "obstacle", active_from: float = 0.0) -> Obstacle:
         r"""A rigid body: :math:`y(t) = c + R(t)(Y - c) + a(t)` with ``translation`` :math:`a(t)` (3,) and
         ``rotation`` :math:`R(t)` (3, 3) about ``centre`` :math:`c` (default the vertices' mean)."""
         Y = np.array(vertices, dtype=float)
@@ -73,7 +79,7 @@ class Obstacle:
             R = np.eye(3) if rotation is None else np.asarray(rotation(t), dtype=float)
             return (Y - c) @ R.T + c + np.asarray(translation(t), dtype=float) - Y
 
-        return cls(Y, triangles, motion, name)
+        return cls(Y, triangles, motion, name, active_from)
 
     @classmethod
     def rectangle(cls, centre, normal, size: float, divisions: int = 1,
