@@ -17,7 +17,8 @@ Modelled
 * **Inert connectors**: ``CONN3D2`` of translational types (``Slot``, ...) between nodes held in dofs 1-3 cannot act
   and are dropped.
 * **Contact with the arms** (``*Contact Pair`` / ``*Contact Inclusions`` with an arm surface): the arms' whole facet
-  surface is an obstacle of the frictionless IPC barrier, from total time 0.
+  surface is an obstacle of the frictionless IPC barrier, from the total time the arm starts to turn
+  (:class:`~skvalve.fem.contact.obstacles.Obstacle` ``active_from``).
 
 Approximated (a note on the model)
 ----------------------------------
@@ -25,8 +26,9 @@ Approximated (a note on the model)
   ``Rough_Interaction``: once touching, bonded): frictionless barrier contact, so a captured leaflet may slide
   and separate. The tie after capture is a separate piece (a history-dependent bond: a node that touches a
   ``Contact_Surf`` facet held by a penalty spring to that material point of the arm, committed per step).
-* The arms are obstacles in every step, also before the step that defines their contact (Abaqus lets a leaflet pass
-  a parked arm there).
+* Contact with an arm starts when it starts to turn (the start of *Clip close*), not with the step that defines it
+  (*Clip capture*): the leaflets closed in the step before overlap the parked arms, which the barrier cannot start
+  from; the capture step's released pressure reopens the valve first.
 
 Still refused, with the file line
 ---------------------------------
@@ -245,7 +247,7 @@ def _changing_dofs(histories: dict[tuple[int, int], History], modelled: np.ndarr
 
 def approximation_notes(abaqus: AbaqusModel, step: int | None = None) -> list[str]:
     """What the model represents only approximately (module docstring): bonded contact with the clip arms as the
-    frictionless barrier, and arms that are obstacles before the step that defines their contact."""
+    frictionless barrier, and arm contact that starts when the arm starts to turn, not with its step."""
     parts = _rigid_parts(abaqus, _histories(abaqus, step))
     if not parts.arm_elements:
         return []
@@ -264,7 +266,7 @@ def approximation_notes(abaqus: AbaqusModel, step: int | None = None) -> list[st
                     notes.append(note)
     if first is not None and first[0] > 0:
         notes.append(f"{first[2]}: contact with the clip arms starts in step {first[0] + 1} ({first[1]!r}) in the "
-                     "input; the IPC barrier holds the arms off the leaflets from total time 0")
+                     "input; the IPC barrier takes each arm in from when it starts to turn")
     return notes
 
 
