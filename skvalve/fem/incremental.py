@@ -20,10 +20,9 @@ direction :math:`p`, with :math:`A` chosen by ``direction``:
   tangent :math:`\mathcal P[K] + M/h^2` (below), and only if that is not definite either (the follower pressure's
   symmetric part is not projected), with Marquardt's diagonal :math:`D = |\mathrm{diag}|` and the smallest shift
   :math:`\mu` of :math:`0, 10^{-6}, 10^{-5}, \dots` for which :math:`A + \mu D` is positive definite
-  (:func:`shifted_newton`). Once the tangent was indefinite in a step, Newton's step is tried again only below
-  ``newton_below``. On the Texas TriValve leaflet's papillary stage the tangent with the pseudo-mass was definite at
-  every iteration and the steps took 204 iterations against 284 projected (77 s against 152 s); on the whole valve's
-  held load it was not (16 048 of 18 920 F-bar blocks indefinite), and a shift of :math:`K_s` alone needed
+  (:func:`shifted_newton`). On the Texas TriValve leaflet's papillary stage the tangent with the pseudo-mass was
+  definite at most iterations and the steps took 204 iterations against 284 projected (77 s against 152 s); on the
+  whole valve's held load it was not (16 048 of 18 920 F-bar blocks indefinite), and a shift of :math:`K_s` alone needed
   0.01-1 |diag|, which stiffens every direction and left the steps crawling.
 * ``"projected"`` (also the fallback without PARDISO): :math:`A = \mathcal P[K] + M/h^2`, the tangent whose element
   blocks (and each contact stencil, ``Contribution.projected_matrix``; a truss's own closed form, ``Blocks.projected``)
@@ -284,12 +283,8 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
         if shifted:
             K = problem.tangent_matrix(tangent)
             H = 0.5 * (K + K.T) + sp.diags(inertia[free], format="csr")  # K itself where every term has a potential
-            # once H was indefinite in this step, Newton's step is tried again only close to the solution (a
-            # factorisation saved per iteration where the projected matrix carries the step)
-            newton_first = not projected or norm <= opts.newton_below * reference
             direction, shift, projected = shifted_newton(H, -gradient[free], shift, solver,
-                                                         fallback=partial(projected_with_mass, tangent),
-                                                         newton_first=newton_first)
+                                                         fallback=partial(projected_with_mass, tangent))
             newton = shift == 0.0 and not projected and energy_merit
             if shift < NEWTON_AGAIN_BELOW and not energy_merit and norm <= opts.newton_below * reference:
                 # near the solution: the full (non-symmetric) tangent for Newton's rate, where it points downhill
@@ -432,15 +427,16 @@ def _past_the_minimum(problem: Problem, u: np.ndarray, p: np.ndarray, alpha: flo
 
 
 def shifted_newton(H: sp.spmatrix, rhs: np.ndarray, shift: float, solver: str,
-                   fallback: Callable[[], sp.spmatrix] | None = None, newton_first: bool = True
-                   ) -> tuple[np.ndarray, float, bool]:
+                   fallback: Callable[[], sp.spmatrix] | None = None) -> tuple[np.ndarray, float, bool]:
     r"""The direction :math:`p = (A + \mu D)^{-1}\,\text{rhs}` for the first positive definite matrix (PARDISO's
     inertia) of: Newton's :math:`A = H` unshifted; then, with a ``fallback`` :math:`A = \mathcal P[H]` (its element
     blocks projected onto their positive semidefinite parts, :func:`projected_tangent`), else :math:`A = H`, with
     Marquardt's diagonal :math:`D = |\text{diag}\,A|` and the smallest shift :math:`\mu` of the sequence
     :math:`0, \mu_0, 10\mu_0, \dots` (starting from a hundredth of the last iteration's ``shift``, or from 0 when it
-    was below ``NEWTON_AGAIN_BELOW``). Returns ``(p, mu, projected)``. ``newton_first`` False (with a fallback):
-    straight to the fallback, where the caller knows :math:`H` was indefinite a moment ago.
+    was below ``NEWTON_AGAIN_BELOW``). Returns ``(p, mu, projected)``. Newton's step is tried at every call: going
+    straight to the fallback once :math:`H` had been indefinite in a step (a factorisation saved per iteration) left
+    the 1.0 posterior leaflet's papillary steps converging linearly on the projected matrix, cut back to 0.004-0.008
+    of step time.
 
     A positive definite matrix makes ``p`` a descent direction, and :math:`\mu = 0` on :math:`H` is Newton's step,
     so the iteration is quadratic near a stable minimum. Away from one the projection keeps every element's
@@ -451,10 +447,9 @@ def shifted_newton(H: sp.spmatrix, rhs: np.ndarray, shift: float, solver: str,
     A = sp.csr_matrix(H)
     projected = fallback is not None
     if projected:
-        if newton_first:
-            direction = linsolve.solve_if_definite(A, rhs, solver)
-            if direction is not None:
-                return direction, 0.0, False
+        direction = linsolve.solve_if_definite(A, rhs, solver)
+        if direction is not None:
+            return direction, 0.0, False
         A = sp.csr_matrix(fallback())
     scale = np.abs(A.diagonal())
     scale = np.maximum(scale, 1e-12 * scale.max(initial=0.0))
