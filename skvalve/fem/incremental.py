@@ -442,8 +442,10 @@ def shifted_newton(H: sp.spmatrix, rhs: np.ndarray, shift: float, solver: str,
     so the iteration is quadratic near a stable minimum. Away from one the projection keeps every element's
     positive curvature as it is and drops only its negative part, where a uniform shift stiffens every direction: on
     the 1.0 diseased valve at its held end load 16 048 of 18 920 F-bar element blocks were indefinite (the most
-    negative eigenvalue as large as the block's largest diagonal entry), :math:`H` needed :math:`\mu` = 0.01 and
-    the projected matrix 0.001; the shifted steps crawled (residual 1-2 % lower per 20-40 iterations)."""
+    negative eigenvalue as large as the block's largest diagonal entry); without the pseudo-mass :math:`H` needed
+    :math:`\mu` = 0.01 and the projected matrix 0.001, with it the projected matrix none. There the held steps of
+    pseudo-step 0.08 converged (38 and 28 iterations) where the shifted ones failed at 0.16 and 0.08 and converged
+    only at 0.04."""
     A = sp.csr_matrix(H)
     projected = fallback is not None
     if projected:
