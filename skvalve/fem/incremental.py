@@ -23,7 +23,7 @@ direction :math:`p`, with :math:`A` chosen by ``direction``:
   (:func:`shifted_newton`). On the Texas TriValve leaflet's papillary stage the tangent with the pseudo-mass was
   definite at most iterations and the steps took 204 iterations against 284 projected (77 s against 152 s); on the
   whole valve's held load it was not (16 048 of 18 920 F-bar blocks indefinite), and a shift of :math:`K_s` alone needed
-  0.01-1 |diag|, which stiffens every direction and left the steps crawling.
+  0.01-1 times the diagonal, which stiffens every direction and left the steps crawling.
 * ``"projected"`` (also the fallback without PARDISO): :math:`A = \mathcal P[K] + M/h^2`, the tangent whose element
   blocks (and each contact stencil, ``Contribution.projected_matrix``; a truss's own closed form, ``Blocks.projected``)
   are projected onto their positive semidefinite parts (projected Newton: Teran et al. 2005); once the relative
