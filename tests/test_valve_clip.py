@@ -156,6 +156,10 @@ def test_arms_turn_by_the_prescribed_angles_and_close(clip):
                                                                                              abs=1e-3)
     assert opening(arms[0], arms[1], 2.5) == pytest.approx(opening(arms[2], arms[3], 2.5), abs=1e-3)
     assert opening(arms[0], arms[1], 2.5) == pytest.approx(26.709, abs=1e-3)
+    # the two arms of a clip turn towards each other by the input's angle each: the opening shrinks by twice it
+    for first, second, turn in ((arms[0], arms[1], 1.134464), (arms[2], arms[3], 0.610865)):
+        shrink = opening(first, second, 0.0) - opening(first, second, 2.5)
+        assert shrink == pytest.approx(2.0 * np.degrees(turn), abs=1e-6)
 
 
 def _arm_leaflet_distance(surface_x, surface_triangles, arm_x, arm_triangles):
