@@ -282,26 +282,24 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
         clock = time.perf_counter()
         if shifted:
             K = problem.tangent_matrix(tangent)
-            H = 0.5 * (K + K.T) + sp.diags(inertia[free], format="csr")  # K itself where every term has a potential
+            H = 0.5 * (K + K.T) + mass  # K itself where every term has a potential
             direction, shift, projected = shifted_newton(H, -gradient[free], shift, solver,
                                                          fallback=partial(projected_with_mass, tangent))
             newton = shift == 0.0 and not projected and energy_merit
             if shift < NEWTON_AGAIN_BELOW and not energy_merit and norm <= opts.newton_below * reference:
                 # near the solution: the full (non-symmetric) tangent for Newton's rate, where it points downhill
-                full = linsolve.solve(K + sp.diags(inertia[free], format="csr"), -gradient[free], solver)
+                full = linsolve.solve(K + mass, -gradient[free], solver)
                 if float(full @ gradient[free]) < 0.0:
                     direction, newton = full, True
         else:
             # without a potential: Newton's direction (the projected one need not lower |grad E|); with one:
             # projected Newton until close
             newton = (newton_allowed and norm <= opts.newton_below * reference) or not energy_merit
-            K = problem.tangent_matrix(tangent) if newton else projected_tangent(problem, tangent)
-            K = K + sp.diags(inertia[free], format="csr")
+            K = problem.tangent_matrix(tangent) + mass if newton else projected_with_mass(tangent)
             direction = linsolve.solve(K, -gradient[free], solver, symmetric=problem.symmetric or not newton)
             if newton and not float(direction @ gradient[free]) < 0.0:  # not descent: projected
                 newton = False
-                K = projected_tangent(problem, tangent) + sp.diags(inertia[free], format="csr")
-                direction = linsolve.solve(K, -gradient[free], solver, symmetric=True)
+                direction = linsolve.solve(projected_with_mass(tangent), -gradient[free], solver, symmetric=True)
         p = np.zeros_like(u)
         p[free] = direction
         cap = problem.step_fraction(u, t_new, u + p, t_new)

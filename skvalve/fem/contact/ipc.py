@@ -172,32 +172,29 @@ class IPCContact(Term):
         self.n_body = self.nodes.size
         local = np.full(space.n_scalar, -1, dtype=np.int64)
         local[self.nodes] = np.arange(self.n_body)
-        faces = [local[surface.triangles]]
         rest = [self.X[self.nodes]]
         offset = self.n_body
         self._obstacle_rows = []
         for obstacle in self.obstacles:
             rest.append(obstacle.at(0.0))
-            faces.append(obstacle.triangles + offset)
             self._obstacle_rows.append(slice(offset, offset + obstacle.vertices.shape[0]))
             offset += obstacle.vertices.shape[0]
-        triangles = np.ascontiguousarray(np.concatenate(faces), dtype=np.int32)
         self.rest = np.ascontiguousarray(np.concatenate(rest))
-        whole = ipctk.CollisionMesh(self.rest, ipctk.edges(triangles), triangles)  # every obstacle: areas, extent
         self.diagonal = float(ipctk.world_bbox_diagonal_length(self.rest))
         self.barrier = ipctk.BarrierPotential(self.dhat, self.stiffness, True)
         self.collisions = ipctk.NormalCollisions()
         self.collisions.use_area_weighting = True
         self._built_for: tuple[tuple[bool, ...], np.ndarray] | None = None
-        self.area = np.zeros(space.n_scalar)  # the barrier's area weights: a third of each adjacent triangle
-        self.area[self.nodes] = np.asarray(whole.vertex_areas)[: self.n_body]
-        self._planes = PlaneBarrier(self.planes, self.area[self.nodes], self.dhat) if self.planes else None
         rows = (3 * self.nodes[:, None] + np.arange(3)).ravel()
         select = sp.csr_matrix((np.ones(rows.size), (rows, np.arange(rows.size))),
                                shape=(space.n_dofs, 3 * self.rest.shape[0]))
-        self._phases = CollisionPhases(self.rest, self.n_body, faces[0], self.obstacles, self._obstacle_rows,
-                                       self._body_filter(exclude_within, self_contact), self_contact, select)
-        self._enter(0.0)
+        self._phases = CollisionPhases(self.rest, self.n_body, local[surface.triangles], self.obstacles,
+                                       self._obstacle_rows, self._body_filter(exclude_within, self_contact),
+                                       self_contact, select)
+        phase = self._enter(0.0)
+        self.area = np.zeros(space.n_scalar)  # the barrier's area weights: a third of each adjacent triangle
+        self.area[self.nodes] = np.asarray(phase.mesh.vertex_areas)[: self.n_body]  # the body's faces in any phase
+        self._planes = PlaneBarrier(self.planes, self.area[self.nodes], self.dhat) if self.planes else None
         self._friction_potential = None if friction is None else ipctk.FrictionPotential(friction.slip)
         self._tangential = None
         self._lagged = self.rest.copy()
@@ -329,9 +326,10 @@ class IPCContact(Term):
         """0.9 of the collision-free share of the straight move (ipctk ``compute_collision_free_stepsize``), 1 when
         the whole move is free."""
         V0 = self.positions(u0, t0, phase_at=t1)  # the obstacles active at the end of the move, from its start
-        if self._phases.key(t0) != self._phase.key and ipctk.has_intersections(self.mesh, V0):
-            joining = [o.name for o, was, now in zip(self.obstacles, self._phases.key(t0), self._phase.key,
-                                                     strict=True) if now and not was]
+        before = self._phases.key(t0)
+        if before != self._phase.key and ipctk.has_intersections(self.mesh, V0):
+            joining = [o.name for o, was, now in zip(self.obstacles, before, self._phase.key, strict=True)
+                       if now and not was]
             raise IntersectionError(f"ipc contact: obstacle(s) {', '.join(joining)} join the contact by load factor "
                                     f"{t1:.6g} while the body overlaps them (at {t0:.6g})")
         V1 = self.positions(u1, t1)
