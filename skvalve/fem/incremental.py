@@ -238,7 +238,7 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
     if problem.step_fraction(u_old, t_old, u, t_new) < 1.0:
         raise StepFailed(f"the prescribed motion from load factor {t_old:.6g} to {t_new:.6g} is not collision-free")
 
-    work = _work_terms(problem, u, t_new)  # terms without a potential: their work is integrated along each ray
+    work = problem.work_terms(u, t_new)  # terms without a potential: their work is integrated along each ray
     energy_merit = not work
     if opts.predictor and fixed.size and np.any(u[fixed] != u_old[fixed]):
         u = _consistent_predictor(problem, u_old, u, t_new, predictor, inertia, step, solver, energy_merit)
@@ -248,11 +248,7 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
     def potential(state: np.ndarray) -> float:
         """The potential part of the incremental potential at ``state`` (+inf where a term refuses the state)."""
         d = state - predictor
-        total = 0.5 * float(d @ (inertia * d))
-        for k, term in enumerate(problem.terms):
-            if k not in work:
-                total += float(term.energy(state, t_new))
-        return total
+        return 0.5 * float(d @ (inertia * d)) + problem.potential_energy(state, t_new, skip=work)
 
     def work_force(contributions) -> np.ndarray:
         force = np.zeros(problem.space.n_dofs)
@@ -350,12 +346,6 @@ class _Ray:
         if self.base_work is None:
             return self.potential(state)
         return self.potential(state) + 0.5 * alpha * (self.base_work + float(self.work_force(contributions) @ self.p))
-
-
-def _work_terms(problem: Problem, u: np.ndarray, t: float) -> list[int]:
-    """Indices of the terms with no potential at ``(u, t)`` (``energy`` missing or ``None``)."""
-    return [k for k, term in enumerate(problem.terms)
-            if getattr(term, "energy", None) is None or term.energy(u, t) is None]
 
 
 def _line_search(problem: Problem, u: np.ndarray, p: np.ndarray, cap: float, slope: float, value: float, norm: float,

@@ -12,6 +12,7 @@ with -1).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -303,6 +304,16 @@ class Problem:
                 return None
             total += float(value)
         return total
+
+    def work_terms(self, u: np.ndarray, t: float) -> list[int]:
+        """Indices of the terms with no potential at ``(u, t)`` (``energy`` missing or ``None``: a follower pressure
+        on an open surface); a solver integrates their work along a step and takes the others' energy change."""
+        return [k for k, term in enumerate(self.terms)
+                if getattr(term, "energy", None) is None or term.energy(u, t) is None]
+
+    def potential_energy(self, u: np.ndarray, t: float, skip: Sequence[int] = ()) -> float:
+        r""":math:`\sum_k \Pi_k(u, t)` over the terms not in ``skip`` (those must all have a potential)."""
+        return float(sum(float(term.energy(u, t)) for k, term in enumerate(self.terms) if k not in skip))
 
     # ------------------------------------------------------------------ state
     def commit(self) -> None:

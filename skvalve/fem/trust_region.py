@@ -55,6 +55,7 @@ from tqdm.auto import tqdm
 
 from . import linsolve
 from .errors import ConvergenceError, NonPositiveJacobianError
+from .incremental import ENERGY_RESOLUTION
 from .newton import reference_force
 from .problem import Problem, Tangent
 from .ptc import _checked_edges, _limited, _stretch_changes, with_step_fraction
@@ -305,6 +306,12 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
         u, _ = relax(u, t)
     residual, tangent = problem.assemble(u, t, tangent=True, step=0)
     problem.commit()  # the start is the first accepted state (e.g. blended contact's facing factors are taken there)
+    # the energy change of a step: the potential terms' own energies (exact, where a barrier's singular growth defeats
+    # a quadrature) plus the work of the terms without a potential along it (Simpson's rule); the work of the whole
+    # residual where the energies' difference is below their rounding (ENERGY_RESOLUTION |E|) within a tenth of the
+    # acceptance margin eta |m|
+    work_terms = problem.work_terms(u, t)
+    energy = problem.potential_energy(u, t, skip=work_terms)
     result.timings["assembly"] += time.perf_counter() - clock
     norm = float(np.linalg.norm(residual[free]))
     relative = norm / reference_force(problem, residual, fixed)
@@ -358,6 +365,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                     problem.commit()
                     p, residual, tangent, work, largest = tried
                     u = u + p
+                    energy = problem.potential_energy(u, t, skip=work_terms)
                     norm = float(np.linalg.norm(residual[free]))
                     relative = norm / reference_force(problem, residual, fixed)
                     retry_below = math.inf
@@ -415,10 +423,11 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             predicted = float(r_free @ p_free + 0.5 * p_free @ ((symmetric_K if newton else model) @ p_free))
             clock = time.perf_counter()
             try:
-                middle, _ = _residual(problem, u + 0.5 * p, t, step)
+                middle, middle_tangent = _residual(problem, u + 0.5 * p, t, step)
                 trial_residual, trial_tangent = problem.assemble(u + p, t, tangent=True, step=step)
                 if not np.all(np.isfinite(trial_residual)):
                     raise _Attempt("the residual is not finite")
+                trial_energy = problem.potential_energy(u + p, t, skip=work_terms)
             except (NonPositiveJacobianError, _Attempt) as err:
                 result.timings["assembly"] += time.perf_counter() - clock
                 problem.rewind()
@@ -429,8 +438,11 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                     print(f"  rejected step {step}: {err}; radius {radius:.3g}", flush=True)
                 continue
             result.timings["assembly"] += time.perf_counter() - clock
-            nodal_work = _nodal_work(residual, middle, trial_residual, p, free, space)
-            work = float(nodal_work.sum())
+            nodal_work = _nodal_work(residual, middle, trial_residual, p, free, space)  # where the energy went
+            if abs(predicted) * opts.eta >= 10.0 * ENERGY_RESOLUTION * abs(energy):
+                work = trial_energy - energy + _work_of(work_terms, (tangent, middle_tangent, trial_tangent), p, free)
+            else:  # the energies' difference is lost in their rounding: the work of the whole residual
+                work = float(nodal_work.sum())
             ratio = work / predicted if predicted < 0.0 else -math.inf
             if not (work < 0.0 and ratio >= opts.eta):
                 problem.rewind()
@@ -453,6 +465,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             local *= opts.local_decay
             local[local < opts.min_shift] = 0.0
             u, residual, tangent = u + p, trial_residual, trial_tangent
+            energy = problem.potential_energy(u, t, skip=work_terms)  # after the commit (a term's state may move it)
             problem.check_state(u, t)
             if relax is not None:
                 clock = time.perf_counter()
@@ -462,6 +475,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                     residual, tangent = problem.assemble(u, t, tangent=True, step=step)
                     problem.commit()
                     work += inner.energy_change
+                    energy = problem.potential_energy(u, t, skip=work_terms)
                 result.timings["assembly"] += time.perf_counter() - clock
             norm = float(np.linalg.norm(residual[free]))
             relative = norm / reference_force(problem, residual, fixed)
@@ -537,6 +551,17 @@ def _negative_eigenvalues(solver, problem, tangent, result) -> int | None:
         return None
     inertia = solver.inertia()
     return None if inertia is None else inertia[1]
+
+
+def _work_of(terms: Sequence[int], tangents: tuple[Tangent, Tangent, Tangent], step: np.ndarray,
+             free: np.ndarray) -> float:
+    """The work of the residual of ``terms`` (indices) along ``step`` by Simpson's rule, from their contributions at
+    the step's start, middle and end (:func:`work_along`)."""
+    if not terms:
+        return 0.0
+    n = step.size
+    start, middle, end = (sum(tangent.contributions[k].residual(n) for k in terms) for tangent in tangents)
+    return work_along(start[free], middle[free], end[free], step[free])
 
 
 def _nodal_work(r_start, r_middle, r_end, step, free, space) -> np.ndarray:
