@@ -396,3 +396,31 @@ def test_shifting_indefinite_blocks_adds_the_smallest_identity_that_makes_each_s
     off = local - plain - np.diag(np.diag(local - plain))
     assert np.abs(off).max() <= 1e-12 * np.abs(plain).max() and np.abs(np.diag(local - plain)[~cable]).max() == 0.0
     assert np.linalg.eigvalsh(plain).min() < 0.0 <= np.linalg.eigvalsh(local).min() + 1e-12
+
+
+@pytest.mark.skipif("pardiso" not in available_solvers(), reason="the inertia needs PARDISO")
+def test_a_run_resumed_from_a_steps_control_repeats_the_uninterrupted_one():
+    """The curled flap under its follower pressure (a work term beside the potentials, Newton tries, shifts that
+    change from step to step): stopped after 7 accepted steps and resumed from that step's state and
+    :class:`TrustRegionControl`, the run takes the same steps to the same state as one that never stopped."""
+    options = TrustRegionOptions(rtol=1e-10, radius=0.2, max_radius=2.0, max_steps=150, newton_below=1e-2)
+    whole_steps = []
+    whole = trust_region(_flap(), 1.0, np.zeros(_flap().space.n_dofs), options, progress=False,
+                         callbacks=[whole_steps.append])
+    assert whole.converged and len(whole.residuals) > 10
+    first_steps = []
+    with pytest.raises(ConvergenceError, match="7 steps without converging"):
+        trust_region(_flap(), 1.0, np.zeros(whole.u.size), replace(options, max_steps=7), progress=False,
+                     callbacks=[first_steps.append])
+    kept = first_steps[-1]
+    assert kept.control.steps == 7 and kept.control.attempts >= 7
+    rest = []
+    resumed = trust_region(_flap(), 1.0, kept.u, options, progress=False, control=kept.control,
+                           callbacks=[rest.append])
+    assert [event.step for event in rest] == list(range(8, len(whole.residuals) + 1))
+    assert np.abs(resumed.u - whole.u).max() <= 1e-10 * np.abs(whole.u).max()
+    # the same steps to rounding (a linear solver reuses its analysis in one run, not across two)
+    assert [event.residual_norm for event in rest] == pytest.approx(whole.residuals[7:], rel=1e-6)
+    with pytest.raises(ValueError, match="local shifts"):
+        trust_region(_flap(), 1.0, kept.u, options, progress=False,
+                     control=replace(kept.control, local=np.zeros(3)))

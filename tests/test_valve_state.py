@@ -7,6 +7,7 @@ import pytest
 
 from skvalve.cli import main
 from skvalve.fem.contact.ipc import Friction
+from skvalve.fem.trust_region import TrustRegionControl
 from skvalve.valve.options import CloseOptions, ContactOptions, HoldOptions, ModelOptions, StepOptions
 from skvalve.valve.state import FORMAT, KeptState, StateError, read_state, write_state
 
@@ -40,8 +41,10 @@ def test_bad_option_names_its_field(make, name):
 
 def _state(n: int = 12) -> KeptState:
     rng = np.random.default_rng(3)
+    control = TrustRegionControl(0.3, 1e-4, 2e-4, rng.standard_normal(n), steps=3, attempts=5, retry_after=9,
+                                 energy_changes=[-0.5, -0.25, -1e-3])
     return KeptState(0.375, rng.standard_normal(n), "Valve.inp", _options(), "hold", 0.125, 17, 3, 211, 2.5e-5,
-                     {"contact/stiffness": np.array(1.25), "contact/lag": rng.standard_normal((4, 3))})
+                     {"contact/stiffness": np.array(1.25), "contact/lag": rng.standard_normal((4, 3))}, 1, control)
 
 
 def test_state_round_trip_is_exact(tmp_path):
@@ -55,6 +58,11 @@ def test_state_round_trip_is_exact(tmp_path):
     assert set(back.terms) == set(state.terms)
     for key, value in state.terms.items():
         np.testing.assert_array_equal(back.terms[key], value)
+    assert back.held_stage == 1  # the held load's trust region resumes with its own controller
+    c, d = back.control, state.control
+    assert d.local.tobytes() == c.local.tobytes() and c.energy_changes == d.energy_changes
+    assert (c.radius, c.shift, c.fallback, c.steps, c.attempts, c.retry_below, c.retry_after) == \
+        (d.radius, d.shift, d.fallback, d.steps, d.attempts, d.retry_below, d.retry_after)
     assert [p.name for p in tmp_path.iterdir()] == ["state.npz"]  # no temporary left behind
 
 

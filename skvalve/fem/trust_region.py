@@ -47,7 +47,7 @@ import logging
 import math
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -72,7 +72,8 @@ from .trust_steps import (
     step_matrix,
 )
 
-__all__ = ["TrustRegionOptions", "TrustRegionStep", "TrustRegionResult", "trust_region", "step_matrix",
+__all__ = ["TrustRegionControl", "TrustRegionOptions", "TrustRegionStep", "TrustRegionResult", "trust_region",
+           "step_matrix",
            "project_psd", "project_sparse_psd", "work_along", "fitted_shift"]
 
 logger = logging.getLogger("skvalve.fem")
@@ -136,6 +137,9 @@ class TrustRegionOptions:
         as much; under a uniform one only the modes softer than :math:`\alpha D` are damped.
     rtol, atol : float
         Converged when :math:`\lVert R_f\rVert \le \max(\text{atol}, \text{rtol}\,f_\text{ref})`.
+    reference : float or None
+        :math:`f_\text{ref}` of the relative residual (``rtol``, ``newton_below``): a force the caller knows better
+        (e.g. a valve's end load) than the default, the reactions' and loads' norm.
     max_steps : int
         The most accepted steps.
     stall_fraction, stall_window : float, int
@@ -168,6 +172,7 @@ class TrustRegionOptions:
     shift_scaling: str = "diagonal"
     rtol: float = 1e-6
     atol: float = 0.0
+    reference: float | None = None
     max_steps: int = 500
     stall_fraction: float = 0.0
     stall_window: int = 20
@@ -201,6 +206,8 @@ class TrustRegionOptions:
                                                           and self.max_strain_increment > 0):
             raise ValueError("TrustRegionOptions.max_strain_increment must be None or positive; "
                              f"got {self.max_strain_increment!r}")
+        if self.reference is not None and not (math.isfinite(self.reference) and self.reference > 0):
+            raise ValueError(f"TrustRegionOptions.reference must be None or a positive force; got {self.reference!r}")
         if not (math.isfinite(self.atol) and self.atol >= 0):
             raise ValueError(f"TrustRegionOptions.atol must be finite and >= 0; got {self.atol!r}")
         if not (isinstance(self.max_steps, int) and self.max_steps > 0):
@@ -208,6 +215,34 @@ class TrustRegionOptions:
         if not (0.0 <= self.stall_fraction < 1.0) or not (isinstance(self.stall_window, int) and self.stall_window > 1):
             raise ValueError("TrustRegionOptions: need 0 <= stall_fraction < 1 and an integer stall_window > 1; got "
                              f"{self.stall_fraction!r}, {self.stall_window!r}")
+
+
+@dataclass
+class TrustRegionControl:
+    """The controller between two steps: all a run resumed from an accepted step needs to repeat the uninterrupted one
+    (pass it as ``control`` to :func:`trust_region`; each :class:`TrustRegionStep` carries a copy).
+
+    ``steps`` accepted steps and ``attempts`` tried ones so far, the radius, the shift and the last positive shift
+    (``fallback``), the local shifts (one per dof), when a failed Newton try may be repeated, and the accepted steps'
+    energy changes (the stall test)."""
+
+    radius: float
+    shift: float
+    fallback: float
+    local: np.ndarray
+    steps: int = 0
+    attempts: int = 0
+    retry_below: float = math.inf
+    retry_after: int = 0
+    energy_changes: list[float] = field(default_factory=list)
+
+    @classmethod
+    def start(cls, options: TrustRegionOptions, n_dofs: int) -> TrustRegionControl:
+        """The controller of a fresh run: the options' first radius and shift, no local shifts."""
+        return cls(options.radius, options.shift, options.shift, np.zeros(n_dofs))
+
+    def copy(self) -> TrustRegionControl:
+        return replace(self, local=self.local.copy(), energy_changes=list(self.energy_changes))
 
 
 @dataclass
@@ -224,6 +259,8 @@ class TrustRegionStep:
     ratio: float
     shift: float
     radius: float
+    control: TrustRegionControl | None = None  # the controller after this step (resume from it)
+    largest: float = math.nan  # the step's largest nodal motion
 
 
 @dataclass
@@ -266,7 +303,8 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                  edges: np.ndarray | None = None, rest_lengths: np.ndarray | None = None,
                  callbacks: Sequence[Callable[[TrustRegionStep], None]] = (), progress: bool = True,
                  verbose: bool = False, relax: Callable[[np.ndarray, float], tuple] | None = None,
-                 limit: Callable[[np.ndarray, np.ndarray], float] | None = None) -> TrustRegionResult:
+                 limit: Callable[[np.ndarray, np.ndarray], float] | None = None,
+                 control: TrustRegionControl | None = None) -> TrustRegionResult:
     """Relax ``problem`` at the held load factor ``t`` from ``u0`` to an equilibrium (module docstring).
 
     ``relax``: a :class:`~skvalve.fem.block_relaxation.BlockRelaxation` (``relax(u, t) -> (u, result)``, the result
@@ -276,6 +314,9 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
     ``limit``: ``limit(u, p) -> f`` in (0, 1], the fraction of a step ``p`` (already held to the radius) that may be
     taken (e.g. :func:`~skvalve.fem.contact.clearance.clearance_fraction`: no node carried through a contact sheet);
     it applies to Newton tries too.
+
+    ``control``: the :class:`TrustRegionControl` of an earlier run's accepted step (``event.control``), to go on from
+    its state ``u0`` as that run would have (``max_steps`` counts the steps of both).
 
     ``edges``/``rest_lengths`` as in :func:`~skvalve.fem.ptc.pseudo_transient`. Returns a :class:`TrustRegionResult`
     with ``converged`` (or ``stalled``: :attr:`TrustRegionOptions.stall_fraction`) set; raises
@@ -296,6 +337,10 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
     limit = with_step_fraction(problem, t, limit)  # the terms' own caps (a barrier's collision-free step) too
     pattern = problem.pattern
     fixed, free = pattern.fixed, pattern.free
+
+    def force_scale(residual: np.ndarray) -> float:
+        return opts.reference if opts.reference is not None else reference_force(problem, residual, fixed)
+
     _, values = problem.constrained(t)
     u[fixed] = values
     result = TrustRegionResult(u=u, load_factor=t)
@@ -314,14 +359,17 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
     energy = problem.potential_energy(u, t, skip=work_terms)
     result.timings["assembly"] += time.perf_counter() - clock
     norm = float(np.linalg.norm(residual[free]))
-    relative = norm / reference_force(problem, residual, fixed)
+    relative = norm / force_scale(residual)
     result.relative_residual = relative
-    radius, shift = opts.radius, opts.shift
-    fallback = shift  # the last positive shift: where to start again when a Newton step is not possible
-    local = np.zeros(n)  # local shifts s_i (relative to D)
+    state = control.copy() if control is not None else TrustRegionControl.start(opts, n)
+    if state.local.shape != (n,):
+        raise ValueError(f"control: {state.local.size} local shifts for {n} dofs")
+    radius, shift = state.radius, state.shift
+    fallback = state.fallback  # the last positive shift: where to start again when a Newton step is not possible
+    local = state.local  # local shifts s_i (relative to D)
     space = problem.space
-    bar = tqdm(total=opts.max_steps, disable=not progress, desc="trust region", leave=False)
-    retry_below, retry_after = math.inf, 0  # when a failed Newton try may be repeated
+    bar = tqdm(total=opts.max_steps, initial=state.steps, disable=not progress, desc="trust region", leave=False)
+    retry_below, retry_after = state.retry_below, state.retry_after  # when a failed Newton try may be repeated
 
     def record(step, work, ratio, shift_taken, largest, newton, held_by) -> None:
         result.u, result.relative_residual = u, relative
@@ -336,7 +384,11 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
         if not bar.disable:
             bar.update(1)
             bar.set_postfix(rel=f"{relative:.1e}", shift=f"{shift:.1e}", radius=f"{radius:.2g}")
-        event = TrustRegionStep(problem, step, t, u, norm, relative, work, ratio, shift, radius)
+        state.steps, state.radius, state.shift, state.fallback, state.local = step, radius, shift, fallback, local
+        state.retry_below, state.retry_after = retry_below, retry_after
+        state.energy_changes.append(work)
+        event = TrustRegionStep(problem, step, t, u, norm, relative, work, ratio, shift, radius, state.copy(),
+                                largest)
         for callback in callbacks:
             callback(event)
 
@@ -346,11 +398,15 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                 result.converged = True
                 result.negative_eigenvalues = _negative_eigenvalues(solvers[1], problem, tangent, result)
                 break
-            if len(result.residuals) >= opts.max_steps:
+            if _stalled(state.energy_changes, opts):
+                result.stalled = True
+                break
+            if state.steps >= opts.max_steps:
                 raise _give_up(result, f"{opts.max_steps} steps without converging")
             if radius < opts.min_radius:
                 raise _give_up(result, f"the trust region shrank to {radius:.2e} (below min_radius)")
-            step = len(result.residuals) + 1
+            step = state.steps + 1
+            state.attempts += 1
             clock = time.perf_counter()
             K = problem.tangent_matrix(tangent)
             if relative <= opts.newton_below and (relative <= retry_below or step >= retry_after):
@@ -367,7 +423,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                     u = u + p
                     energy = problem.potential_energy(u, t, skip=work_terms)
                     norm = float(np.linalg.norm(residual[free]))
-                    relative = norm / reference_force(problem, residual, fixed)
+                    relative = norm / force_scale(residual)
                     retry_below = math.inf
                     record(step, work, math.nan, 0.0, largest, True, "newton try")
                     continue
@@ -478,7 +534,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                     energy = problem.potential_energy(u, t, skip=work_terms)
                 result.timings["assembly"] += time.perf_counter() - clock
             norm = float(np.linalg.norm(residual[free]))
-            relative = norm / reference_force(problem, residual, fixed)
+            relative = norm / force_scale(residual)
             shift_taken = 0.0 if newton else shift
             if ratio > 0.75:
                 shift = 0.0 if shift / 10.0 < opts.min_shift else shift / 10.0
@@ -488,9 +544,6 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                 shift = min(max(2.0 * shift, opts.min_shift), opts.max_shift)
                 radius = max(0.5 * largest, opts.min_radius)
             record(step, work, ratio, shift_taken, largest, newton, held_by)
-            if _stalled(result.energy_changes, opts):
-                result.stalled = True
-                break
     finally:
         bar.close()
     return result

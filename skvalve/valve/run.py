@@ -9,12 +9,12 @@ repair afterwards.
 
 Path (:class:`~skvalve.valve.options.StepOptions`): incremental-potential steps
 (:func:`~skvalve.fem.incremental.minimise_step`) with a viscous pseudo-mass :math:`cV_i/\Delta t`, whose length
-grows after easy steps and halves after failed ones. Held load (:class:`~skvalve.valve.options.HoldOptions`): the
-same steps at the end time with the pseudo-step doubling after each converged one (the pseudo-mass fading), each
-converged to a tenth of the static residual it starts from (or, out of iterations, kept when it lowered the static
-residual), and the static problem once the static residual is small, solved to ``rtol`` (1e-6) of the undamped
-problem. The line search's merit is the incremental potential plus the follower pressure's work
-along the ray, by the trapezoidal rule (the pressure on the leaflets' open surface has no potential).
+grows after easy steps and halves after failed ones. The line search's merit is the incremental potential plus the
+follower pressure's work along the ray, by the trapezoidal rule (the pressure on the leaflets' open surface has no
+potential). Held load (:class:`~skvalve.valve.options.HoldOptions`, :func:`held_stages`): the energy trust region
+(:func:`~skvalve.fem.trust_region.trust_region`) at the end time, a *descend* stage of projected steps of up to a
+millimetre until their energy drop stalls, then a *settle* stage on the symmetric tangent with Newton's steps at
+the end, to ``rtol`` (1e-6) of the undamped problem; the chordae branch points are relaxed after every step.
 
 Output in ``out``: ``state.npz`` after every accepted step (atomic, :mod:`skvalve.valve.state`; ``resume=True``
 continues from it and repeats the uninterrupted run), ``closure.log`` (one line per step), and at the end
@@ -34,16 +34,20 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ..fem import linsolve
-from ..fem.errors import NonPositiveJacobianError, SingularSystemError, SolverError
+from ..fem.block_relaxation import BlockRelaxation
+from ..fem.errors import ConvergenceError, NonPositiveJacobianError, SingularSystemError, SolverError
 from ..fem.incremental import IncrementalOptions, StepFailed, minimise_step
+from ..fem.truss import Truss
+from ..fem.trust_region import TrustRegionOptions, TrustRegionStep, trust_region
 from ..io.abaqus import AbaqusModel
 from ..io.files import replace_atomically
-from .options import CloseOptions
+from .options import CloseOptions, HoldOptions
 from .outputs import ClosureWriter
 from .setup import ValveSetup, smallest_corner_jacobian, valve_setup
 from .state import KeptState, read_state, write_state
 
-__all__ = ["ClosureFailed", "CloseReport", "StepRecord", "close_valve", "relative_residual"]
+__all__ = ["ClosureFailed", "CloseReport", "StepRecord", "close_valve", "held_stages", "hub_relaxation",
+           "relative_residual"]
 
 logger = logging.getLogger("skvalve.valve")
 
@@ -57,7 +61,8 @@ class ClosureFailed(SolverError):
 
 @dataclass
 class StepRecord:
-    """One accepted step: phase, step time, step length, iterations, static relative residual, contact pairs."""
+    """One accepted step: phase, step time, step length (path) or largest nodal motion (hold, mm), iterations (held:
+    the trust region's tries, rejected ones included), static relative residual, contact pairs, seconds."""
 
     phase: str
     t: float
@@ -66,12 +71,12 @@ class StepRecord:
     relative_residual: float
     contact_pairs: int
     seconds: float
-    converged: bool = True  # False: a held step kept for its progress after it ran out of iterations
 
     def line(self) -> str:
-        return (f"{self.phase} t={self.t:.6g} dt={self.increment:.3g} iterations={self.iterations} "
+        size = "dt" if self.phase == "path" else "max_du"
+        return (f"{self.phase} t={self.t:.6g} {size}={self.increment:.3g} iterations={self.iterations} "
                 f"relative_residual={self.relative_residual:.3e} contact_pairs={self.contact_pairs} "
-                f"seconds={self.seconds:.2f}{'' if self.converged else ' unconverged'}")
+                f"seconds={self.seconds:.2f}")
 
 
 @dataclass
@@ -110,12 +115,11 @@ def relative_residual(setup: ValveSetup, residual: np.ndarray) -> float:
 
 
 class _Outcome(NamedTuple):
-    """A step's end: state, static residual (all dofs), iteration history, whether it met its tolerance."""
+    """A step's end: state, static residual (all dofs), iteration history."""
 
     u: np.ndarray
     residual: np.ndarray
     history: list[dict]
-    converged: bool
 
 
 class _Run:
@@ -135,9 +139,6 @@ class _Run:
         self.progress = progress
         self.solver = linsolve.solver_name(options.solver)
         self.lines: list[str] = []
-        # the static relative residual at which the static problem last failed: it is tried again only once the held
-        # steps have lowered the residual tenfold (from an unchanged state it would fail the same way)
-        self.static_failed_at = float("inf")
 
     # ------------------------------------------------------------ kept state
     def resume(self, kept: KeptState) -> None:
@@ -146,10 +147,12 @@ class _Run:
         if self.out is not None and (self.out / LOG_FILE).is_file():
             self.lines = (self.out / LOG_FILE).read_text().splitlines()
 
-    def keep(self, record: StepRecord) -> None:
-        self.records.append(record)
+    def keep(self, record: StepRecord | None) -> None:
+        """Write the kept state (with the terms' committed state) and the log, after ``record`` (None: no new step)."""
+        if record is not None:
+            self.records.append(record)
+            self.lines.append(record.line())
         self.state.terms = self.problem.state()
-        self.lines.append(record.line())
         if self.out is not None:
             write_state(self.out / STATE_FILE, self.state)
             text = "\n".join(self.lines) + "\n"
@@ -169,20 +172,11 @@ class _Run:
                                              s.steps + s.held_steps + 1, opts, self.solver)
         return u, residual, history
 
-    def attempt(self, t_new: float, inertia_scale: float, rtol: float, max_iter: int,
-                progress_only: bool = False) -> _Outcome | None:
-        """:meth:`step`, or ``None`` after rewinding the terms when it fails. ``progress_only``: a step that ran out
-        of iterations is still kept (unconverged) when its last iterate's static residual is below the kept
-        state's (a held step only has to make progress towards the static equilibrium)."""
+    def attempt(self, t_new: float, inertia_scale: float, rtol: float, max_iter: int) -> _Outcome | None:
+        """:meth:`step`, or ``None`` after rewinding the terms when it fails."""
         try:
-            return _Outcome(*self.step(t_new, inertia_scale, rtol, max_iter), True)
+            return _Outcome(*self.step(t_new, inertia_scale, rtol, max_iter))
         except (StepFailed, NonPositiveJacobianError, SingularSystemError, np.linalg.LinAlgError) as err:
-            last = getattr(err, "last", None) if progress_only else None
-            if last is not None and relative_residual(self.setup, last[1]) < self.state.relative_residual:
-                u, _, history = last
-                residual, _ = self.problem.assemble(u, t_new, tangent=False)  # the terms' last state is u's
-                logger.info("held step to t=%.6g kept unconverged after %d iterations: %s", t_new, len(history), err)
-                return _Outcome(u, residual, history, False)
             self.problem.rewind()
             self.failed += 1
             logger.info("step to t=%.6g failed: %s", t_new, err)
@@ -200,12 +194,6 @@ class _Run:
         s.iterations += len(history)
         return relative
 
-    def idle(self, rtol: float) -> bool:
-        """True when the kept state already meets a damped step's convergence test at ``rtol`` (:meth:`step`), so
-        that a damped held step would accept it without an iteration."""
-        residual, _ = self.problem.assemble(self.state.u, self.end, tangent=False)
-        return relative_residual(self.setup, residual) <= rtol
-
     # ------------------------------------------------------------ phases
     def path(self, bar) -> None:
         opts, s = self.options.steps, self.state
@@ -222,7 +210,7 @@ class _Run:
                     raise ClosureFailed(f"{s.input}: load step {s.steps + 1} from step time {s.t:.6g} failed at "
                                         f"every length down to {opts.smallest:g}: {self.last_error}")
                 continue
-            u, residual, history, _ = outcome
+            u, residual, history = outcome
             step_length = t_new - s.t
             relative = self.accept(u, t_new, residual, history)
             s.steps += 1
@@ -238,62 +226,81 @@ class _Run:
             bar.set_postfix(it=len(history), res=f"{relative:.1e}", pairs=pairs, dt=f"{step_length:.2g}")
 
     def hold(self, bar) -> None:
-        opts, steps, s = self.options.hold, self.options.steps, self.state
+        opts, s = self.options.hold, self.state
         if opts.max_steps == 0:  # the path only (e.g. a run that stops part-way along the load path)
             return
         if not any(float(np.max(np.abs(load.at(self.end)))) > 0.0 for load in self.setup.model.pressures):
             # before the pressure: leaflets hanging from chordae and annulus have no unique static state to hold
             logger.warning("%s: no pressure at step time %.6g: the path only, no held load", s.input, self.end)
             return
-        while s.phase == "hold":
-            if s.held_steps >= opts.max_steps:
-                raise ClosureFailed(f"{s.input}: held load not converged in {opts.max_steps} steps (relative "
-                                    f"residual {s.relative_residual:.3e}; the kept state is the last one)")
-            clock = time.perf_counter()
-            # a damped held step converges to a tenth of the static residual it starts from (a forcing term: at the
-            # path's looser tolerance a state the path left at, say, 0.9 of it would be accepted as it is, and the
-            # held steps would not move), not looser than the path's tolerance (on the 1.0 diseased valve's held
-            # load, at a static residual of 0.2, held steps converged to a tenth of it let the static residual rise,
-            # 0.2067 -> 0.2086 -> 0.2119, where steps converged to 1e-3 lowered it at every step), and not below the
-            # hold's aim
-            forcing = (min(steps.rtol, max(opts.rtol, 0.1 * s.relative_residual))
-                       if np.isfinite(s.relative_residual) else steps.rtol)
-            # the static problem once the static residual is small, or where a damped held step would find nothing to
-            # do at its tolerance (a held load with hardly any reaction: the relative residual stays large however
-            # long the pseudo-step grows)
-            idle = self.idle(forcing)
-            small = np.isfinite(s.relative_residual) and s.relative_residual <= opts.static_below
-            static = idle or (small and s.relative_residual <= 0.1 * self.static_failed_at)
-            outcome = self.attempt(self.end, 0.0, opts.rtol, steps.max_iter) if static else None
-            if outcome is None:
-                if static:
-                    self.static_failed_at = s.relative_residual
-                if idle:
-                    raise ClosureFailed(f"{s.input}: the static problem at step time {self.end:.6g} failed "
-                                        f"({self.last_error}) and a damped held step has nothing left to do at its "
-                                        "tolerance (the kept state is the last one)")
-                outcome = self.attempt(self.end, steps.damping / s.increment, forcing, steps.max_iter,
-                                       progress_only=True)
-                if outcome is None:
-                    s.increment *= 0.5
-                    if s.increment < steps.smallest:
-                        raise ClosureFailed(f"{s.input}: held step {s.held_steps + 1} failed at every pseudo-step "
-                                            f"down to {steps.smallest:g}: {self.last_error}")
-                    continue
-                pseudo = s.increment
-                if outcome.converged:  # each converged held step lets the pseudo-mass fade (HoldOptions.growth)
-                    s.increment *= opts.growth
-            else:
-                pseudo = float("inf")
-            u, residual, history, converged = outcome
-            relative = self.accept(u, self.end, residual, history)
+        stages = held_stages(opts, self.setup.load_norm, self.options.solver)
+        hubs = hub_relaxation(self.setup)
+        clock = [time.perf_counter()]
+
+        def keep_step(event: TrustRegionStep) -> None:
+            attempts = event.control.attempts - (s.control.attempts if s.control is not None else 0)
+            s.u, s.relative_residual, s.control = event.u, float(event.relative_residual), event.control
             s.held_steps += 1
-            if relative <= opts.rtol:
+            s.iterations += attempts
+            pairs = self.setup.contact.active_pairs(event.u, self.end)
+            self.keep(StepRecord("hold", self.end, event.largest, attempts, s.relative_residual, pairs,
+                                 time.perf_counter() - clock[0]))
+            clock[0] = time.perf_counter()
+            bar.set_postfix(stage=s.held_stage + 1, held=s.held_steps, res=f"{s.relative_residual:.1e}", pairs=pairs)
+
+        while s.phase == "hold":
+            last = s.held_stage == len(stages) - 1
+            try:
+                result = trust_region(self.problem, self.end, s.u, stages[s.held_stage], callbacks=[keep_step],
+                                      progress=False, relax=hubs, control=s.control)
+            except ConvergenceError as err:
+                if last:
+                    raise ClosureFailed(f"{s.input}: held load not converged ({err}; the kept state is the last "
+                                        "accepted step)") from err
+                result = None
+            s.u = s.u if result is None or result.u is None else result.u
+            if result is not None and result.converged:
                 s.phase = "done"
-            pairs = self.setup.contact.active_pairs(u, self.end)
-            self.keep(StepRecord("hold", self.end, pseudo, len(history), relative, pairs,
-                                 time.perf_counter() - clock, converged))
-            bar.set_postfix(held=s.held_steps, it=len(history), res=f"{relative:.1e}", pairs=pairs)
+                residual, _ = self.problem.assemble(s.u, self.end, tangent=False)
+                s.relative_residual = relative_residual(self.setup, residual)
+            elif not last:  # the descend stage stalled or used its steps: the settle stage from its last state
+                s.held_stage, s.control = s.held_stage + 1, None
+                logger.info("%s: held stage %d from relative residual %.3e", s.input, s.held_stage + 1,
+                            s.relative_residual)
+            else:
+                raise ClosureFailed(f"{s.input}: the held load's last stage stalled at relative residual "
+                                    f"{s.relative_residual:.3e}")
+            self.keep(None)
+
+
+def held_stages(options: HoldOptions, load_norm: float, solver: str | None = None) -> list[TrustRegionOptions]:
+    """The held load's two trust-region stages (:class:`~skvalve.valve.options.HoldOptions`): *descend* (projected
+    step matrix, Marquardt's diagonal shift, steps scaled into the radius, until the energy drop stalls) and *settle*
+    (the symmetric tangent, a uniform shift fitted to the radius, the IPC contact's indefinite blocks shifted locally,
+    Newton's full-tangent steps below ``newton_below``); residuals relative to the end load's nodal forces."""
+    common = {"radius": 0.25 * options.max_radius, "max_radius": options.max_radius, "rtol": options.rtol,
+              "reference": load_norm, "max_steps": options.max_steps, "max_strain_increment": None,
+              "newton_below": options.newton_below, "solver": solver}
+    descend = TrustRegionOptions(project=True, stall_fraction=options.stall_fraction, **common)
+    settle = TrustRegionOptions(project=False, fit_radius=3, shift_scaling="uniform", shift_terms=("ipc contact",),
+                                **common)
+    return [descend, settle]
+
+
+def hub_relaxation(setup: ValveSetup) -> BlockRelaxation | None:
+    """The chordae branch points (vertices of no leaflet cell, not prescribed) brought to equilibrium by the cables
+    alone with the rest held (:mod:`skvalve.fem.block_relaxation`): a global step that sees a hub's slack side
+    overshoots it, and unbalanced hubs would carry the residual (on the 1.0 diseased valve's held load, without it, 50
+    hub nodes carried 96 % of the residual's square after 30 steps). None when the model has none."""
+    problem = setup.problem
+    in_cell = np.zeros(problem.space.n_u // problem.space.dim, dtype=bool)
+    in_cell[np.unique(setup.model.mesh.t)] = True
+    trusses = [term for term in problem.terms if isinstance(term, Truss)]
+    hubs = np.flatnonzero(~in_cell)
+    if hubs.size == 0 or not trusses:
+        return None
+    relax = BlockRelaxation(problem, problem.space.displacement_dofs(hubs).ravel(), trusses)
+    return relax if relax.dofs.size else None
 
 
 def close_valve(source: str | Path | AbaqusModel, options: CloseOptions | None = None, out: str | Path | None = None,
@@ -313,7 +320,8 @@ def close_valve(source: str | Path | AbaqusModel, options: CloseOptions | None =
     if resume:
         if out is None:
             raise ValueError("close_valve: resume needs an output folder (out)")
-        kept = read_state(out / STATE_FILE, input_name=Path(str(getattr(source, "path", source))).name)
+        name = setup.input_name if setup is not None else Path(str(getattr(source, "path", source))).name
+        kept = read_state(out / STATE_FILE, input_name=name)
         options = kept.options
     options = options or CloseOptions()
     setup = setup or valve_setup(source, options)

@@ -1,8 +1,9 @@
 """The kept state of a valve closure: what a run writes after every step and resumes from.
 
 One ``.npz`` file (written atomically, :func:`~skvalve.io.files.replace_atomically`) with the step time, the
-displacement, the step controller (next step length, step count, held steps and held pseudo-step), the name of the
-input, the run's :class:`~skvalve.valve.options.CloseOptions` as JSON, and every stateful term's committed state
+displacement, the step controller (next step length, step count, held steps, the held stage and its trust region's
+:class:`~skvalve.fem.trust_region.TrustRegionControl`), the name of the input, the run's
+:class:`~skvalve.valve.options.CloseOptions` as JSON, and every stateful term's committed state
 (:meth:`~skvalve.fem.problem.Problem.state`: the IPC barrier's stiffness and friction lag). A run resumed from it
 repeats the uninterrupted one (same steps, same iterates).
 """
@@ -16,14 +17,16 @@ from pathlib import Path
 
 import numpy as np
 
+from ..fem.trust_region import TrustRegionControl
 from ..io.files import replace_atomically
 from .options import CloseOptions
 
 __all__ = ["KeptState", "StateError", "read_state", "write_state"]
 
 #: format version of the kept state; a file of another version is refused
-FORMAT = 2
+FORMAT = 3
 _TERM_PREFIX = "term:"
+_CONTROL_SCALARS = ("radius", "shift", "fallback", "steps", "attempts", "retry_below", "retry_after")
 
 
 class StateError(ValueError):
@@ -34,8 +37,9 @@ class StateError(ValueError):
 class KeptState:
     """A closure state: step time ``t``, displacement ``u``, the controller, the input and the options.
 
-    ``phase`` is ``"path"`` (loading), ``"hold"`` (held load, pseudo-mass fading) or ``"done"``; ``increment`` the next
-    step length (path) or pseudo-step (hold); ``relative_residual`` the static residual at ``u``.
+    ``phase`` is ``"path"`` (loading), ``"hold"`` (held load) or ``"done"``; ``increment`` the next path step's length;
+    ``held_stage`` the held load's stage (0 descend, 1 settle) and ``control`` its trust region's controller after the
+    last held step (None before the stage's first); ``relative_residual`` the static residual at ``u``.
     """
 
     t: float
@@ -49,6 +53,8 @@ class KeptState:
     iterations: int = 0
     relative_residual: float = float("nan")
     terms: dict[str, np.ndarray] = field(default_factory=dict)
+    held_stage: int = 0
+    control: TrustRegionControl | None = None
 
     def __post_init__(self) -> None:
         if self.phase not in ("path", "hold", "done"):
@@ -61,7 +67,11 @@ def write_state(path: str | Path, state: KeptState) -> Path:
     scalars = {"format": FORMAT, "t": state.t, "phase": state.phase, "increment": state.increment,
                "steps": state.steps, "held_steps": state.held_steps, "iterations": state.iterations,
                "relative_residual": state.relative_residual, "input": state.input,
-               "options": json.dumps(state.options.as_dict())}
+               "options": json.dumps(state.options.as_dict()), "held_stage": state.held_stage}
+    if state.control is not None:
+        c = state.control
+        scalars["control"] = json.dumps({name: getattr(c, name) for name in _CONTROL_SCALARS})
+        arrays["control_local"], arrays["control_energy_changes"] = c.local, np.asarray(c.energy_changes, dtype=float)
     return replace_atomically(Path(path), lambda temporary: np.savez(temporary, u=state.u, **scalars, **arrays))
 
 
@@ -96,6 +106,15 @@ def read_state(path: str | Path, input_name: str | None = None, n_dofs: int | No
     except (TypeError, KeyError, ValueError) as err:
         raise StateError(f"kept state {path}: its options do not read ({err})") from err
     terms = {key[len(_TERM_PREFIX):]: value for key, value in content.items() if key.startswith(_TERM_PREFIX)}
+    control = None
+    if "control" in content:
+        try:
+            scalars = json.loads(str(content["control"]))
+            control = TrustRegionControl(local=np.asarray(content["control_local"], dtype=float),
+                                         energy_changes=[float(x) for x in content["control_energy_changes"]],
+                                         **{name: scalars[name] for name in _CONTROL_SCALARS})
+        except (KeyError, TypeError, ValueError) as err:
+            raise StateError(f"kept state {path}: its held-load controller does not read ({err})") from err
     return KeptState(float(content["t"]), u, name, options, str(content["phase"]), float(content["increment"]),
                      int(content["steps"]), int(content["held_steps"]), int(content["iterations"]),
-                     float(content["relative_residual"]), terms)
+                     float(content["relative_residual"]), terms, int(content.get("held_stage", 0)), control)
