@@ -13,9 +13,10 @@ from scipy.optimize import brentq
 
 from skvalve.fem import HyperelasticTerm, MaterialRegions, NodalForce, Problem, Solid, Space, solve
 from skvalve.fem.block_relaxation import BlockRelaxation
-from skvalve.fem.errors import ConvergenceError
+from skvalve.fem.errors import ConvergenceError, StateRefused
 from skvalve.fem.linsolve import LinearSolver, available_solvers
 from skvalve.fem.loads import FollowerPressure
+from skvalve.fem.terms import Contribution, Term
 from skvalve.fem.truss import Truss
 from skvalve.fem.trust_region import (
     TrustRegionOptions,
@@ -424,3 +425,39 @@ def test_a_run_resumed_from_a_steps_control_repeats_the_uninterrupted_one():
     with pytest.raises(ValueError, match="local shifts"):
         trust_region(_flap(), 1.0, kept.u, options, progress=False,
                      control=replace(kept.control, local=np.zeros(3)))
+
+
+class _RefuseFirst(Term):
+    """A term with no forces that refuses the first ``count`` states it is shown (:class:`StateRefused`)."""
+
+    name = "refuse first"
+
+    def __init__(self, space, count: int) -> None:
+        self.space, self.left, self.shown = space, count, 0
+
+    def assemble(self, u, t, tangent=True, step=None):
+        return Contribution()
+
+    def energy(self, u, t):
+        return 0.0
+
+    def check_state(self, u, t):
+        self.shown += 1
+        if self.left > 0:
+            self.left -= 1
+            raise StateRefused("refused by the test")
+
+
+def test_a_refused_trial_is_a_rejected_step_not_a_failure():
+    """A term that refuses a trial state (as the IPC contact refuses a self-intersection among primitives it excludes)
+    makes the trust region reject that step and shorten the radius; the run still ends at Newton's state."""
+    newton = solve(sheared_block(), 10, progress=False, rtol=1e-11).u()
+    block = sheared_block()
+    guard = block.add_term(_RefuseFirst(block.space, 2))
+    plain = trust_region(sheared_block(), 1.0, np.zeros(newton.size), TrustRegionOptions(rtol=1e-11, radius=0.1),
+                         progress=False)
+    result = trust_region(block, 1.0, np.zeros(newton.size), TrustRegionOptions(rtol=1e-11, radius=0.1),
+                          progress=False)
+    assert result.converged and guard.left == 0 and guard.shown > 2
+    assert result.rejected == plain.rejected + 2
+    assert np.abs(result.u - newton).max() <= 1e-9 * np.abs(newton).max()

@@ -30,6 +30,12 @@ class ConvergenceError(SolverError):
     """Newton did not converge after the allowed step cut-backs."""
 
 
+class StateRefused(SolverError):
+    """A term refuses a state its energy does not guard against (:meth:`~skvalve.fem.terms.Term.check_state`: e.g. a
+    self-intersection among collision primitives the barrier excludes); a solver that tries steps rejects such a
+    trial as it rejects an inverted element."""
+
+
 class NonPositiveJacobianError(SolverError):
     """J <= 0 (or not finite) at a quadrature point; names the elements and the load step."""
 

@@ -54,7 +54,7 @@ import scipy.sparse as sp
 from tqdm.auto import tqdm
 
 from . import linsolve
-from .errors import ConvergenceError, NonPositiveJacobianError
+from .errors import ConvergenceError, NonPositiveJacobianError, StateRefused
 from .incremental import ENERGY_RESOLUTION
 from .newton import reference_force
 from .problem import Problem, Tangent
@@ -500,6 +500,20 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             else:  # the energies' difference is lost in their rounding: the work of the whole residual
                 work = float(nodal_work.sum())
             ratio = work / predicted if predicted < 0.0 else -math.inf
+            refused = None
+            if work < 0.0 and ratio >= opts.eta:
+                try:  # a state a term refuses (e.g. primitives the barrier excludes crossing): a rejected step
+                    problem.check_state(u + p, t)
+                except StateRefused as err:
+                    refused = err
+            if refused is not None:
+                problem.rewind()
+                result.rejected += 1
+                radius = 0.5 * largest
+                logger.info("trust-region step %d rejected: %s", step, refused)
+                if verbose:
+                    print(f"  rejected step {step}: {refused}; radius {radius:.3g}", flush=True)
+                continue
             if not (work < 0.0 and ratio >= opts.eta):
                 problem.rewind()
                 result.rejected += 1
@@ -522,7 +536,6 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             local[local < opts.min_shift] = 0.0
             u, residual, tangent = u + p, trial_residual, trial_tangent
             energy = problem.potential_energy(u, t, skip=work_terms)  # after the commit (a term's state may move it)
-            problem.check_state(u, t)
             if relax is not None:
                 clock = time.perf_counter()
                 relaxed, inner = relax(u, t)
@@ -530,6 +543,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                     u = relaxed
                     residual, tangent = problem.assemble(u, t, tangent=True, step=step)
                     problem.commit()
+                    problem.check_state(u, t)
                     work += inner.energy_change
                     energy = problem.potential_energy(u, t, skip=work_terms)
                 result.timings["assembly"] += time.perf_counter() - clock
@@ -585,7 +599,8 @@ def _newton_try(problem, solver, K, residual, u, t, step, radius, norm, opts, re
     clock = time.perf_counter()
     try:
         trial, tangent = problem.assemble(u + p, t, tangent=True, step=step)
-    except NonPositiveJacobianError:
+        problem.check_state(u + p, t)
+    except (NonPositiveJacobianError, StateRefused):
         trial = None
     result.timings["assembly"] += time.perf_counter() - clock
     if trial is None or not np.all(np.isfinite(trial)) or \

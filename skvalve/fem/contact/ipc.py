@@ -62,7 +62,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from ..errors import SolverError
+from ..errors import StateRefused
 from ..space import Space
 from ..terms import Contribution, Term
 from .activation import CollisionPhase, CollisionPhases
@@ -78,8 +78,9 @@ STEP_SAFETY = 0.9
 SMALLEST_FRACTION = 1e-12
 
 
-class IntersectionError(SolverError):
-    """An accepted state whose collision mesh intersects itself (a debug check, :meth:`IPCContact.check_state`)."""
+class IntersectionError(StateRefused):
+    """A state whose collision mesh intersects itself (:meth:`IPCContact.check_state`): where the collision-free step
+    cannot prevent it, between primitives excluded from contact (``exclude_within``)."""
 
 
 @dataclass(frozen=True)
