@@ -461,3 +461,21 @@ def test_a_refused_trial_is_a_rejected_step_not_a_failure():
     assert result.converged and guard.left == 0 and guard.shown > 2
     assert result.rejected == plain.rejected + 2
     assert np.abs(result.u - newton).max() <= 1e-9 * np.abs(newton).max()
+
+
+def test_each_steps_energy_change_is_the_drop_of_the_total_potential():
+    """Where every term has a potential (the sheared block), a resolved step's energy change is the potential's own
+    difference between the accepted states (evaluated here by :meth:`Problem.energy`, not by the solver's
+    quadrature), and the potential falls at every step."""
+    block = sheared_block()
+    states = []
+    result = trust_region(block, 1.0, np.zeros(block.space.n_dofs), TrustRegionOptions(rtol=1e-11, radius=0.1),
+                          progress=False, callbacks=[lambda event: states.append(event.u.copy())])
+    start = np.zeros(block.space.n_dofs)
+    start[block.pattern.fixed] = block.constrained(1.0)[1]
+    energies = [block.energy(state, 1.0) for state in [start, *states]]
+    drops = np.diff(energies)
+    assert np.all(drops < 0.0)
+    resolved = np.abs(drops) > 1e-8 * abs(energies[-1])
+    assert resolved.sum() >= 5
+    np.testing.assert_allclose(np.array(result.energy_changes)[resolved], drops[resolved], rtol=1e-9)
