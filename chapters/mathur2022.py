@@ -613,12 +613,14 @@ if HAVE_DATA:
 #   pressure) in incremental-potential steps (`skvalve.fem.incremental`) of adaptive length, each a minimisation by
 #   shifted Newton with a collision-free line search: every trial is cut to the share of the step that continuous
 #   collision detection finds free, so no iterate passes through a leaflet and no state needs repair. A viscous
-#   pseudo-mass holds the nodes that nothing else holds yet; at the held load it fades, and the static problem is
-#   solved to a relative residual of 1e-6. The state is kept after every accepted step (`DIR/state.npz`, with
-#   `closure.log`; `closure.pvd` at the end), and `--resume` continues an interrupted run from it.
+#   pseudo-mass holds the nodes that nothing else holds yet. At the held load an energy trust region
+#   (`skvalve.fem.trust_region`) takes over: steps of at most a millimetre on any node, accepted by the energy they
+#   release, first on the element-projected tangent until that drop stalls, then on the tangent itself with Newton's
+#   steps at the end, to a relative residual of 1e-6. The state is kept after every accepted step (`DIR/state.npz`,
+#   with `closure.log`; `closure.pvd` at the end), and `--resume` continues an interrupted run from it.
 # * `skvalve reproduce mathur2022 --full --out out/` closes every Texas TriValve input present that way, each in
 #   `out/<key>` and resumed from the state kept there, and prints the Table 2–3 rows of each column with figures and
-#   a VTU/PVD series (the clip repair's column is reported as not computed: its rigid clip arms are not modelled);
+#   a VTU/PVD series (the clip repair's rigid arms are moving IPC obstacles, its three steps in total time);
 #   `skvalve reproduce mathur2022 --state FILE` prints the rows of a kept state without solving.
 # * `benchmarks/trivalve_closure.py` times one `close_valve` call on the 1.0 diseased valve and splits its wall time
 #   (assembly, contact, continuous collision detection, factorisation).

@@ -71,11 +71,13 @@ class StepRecord:
     relative_residual: float
     contact_pairs: int
     seconds: float
+    energy_change: float | None = None  # held steps: the energy the step released (N mm, negative)
 
     def line(self) -> str:
         size = "dt" if self.phase == "path" else "max_du"
+        energy = "" if self.energy_change is None else f" energy_change={self.energy_change:.3e}"
         return (f"{self.phase} t={self.t:.6g} {size}={self.increment:.3g} iterations={self.iterations} "
-                f"relative_residual={self.relative_residual:.3e} contact_pairs={self.contact_pairs} "
+                f"relative_residual={self.relative_residual:.3e} contact_pairs={self.contact_pairs}{energy} "
                 f"seconds={self.seconds:.2f}")
 
 
@@ -244,7 +246,7 @@ class _Run:
             s.iterations += attempts
             pairs = self.setup.contact.active_pairs(event.u, self.end)
             self.keep(StepRecord("hold", self.end, event.largest, attempts, s.relative_residual, pairs,
-                                 time.perf_counter() - clock[0]))
+                                 time.perf_counter() - clock[0], event.energy_change))
             clock[0] = time.perf_counter()
             bar.set_postfix(stage=s.held_stage + 1, held=s.held_steps, res=f"{s.relative_residual:.1e}", pairs=pairs)
 
