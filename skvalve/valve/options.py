@@ -52,11 +52,13 @@ class ContactOptions:
         the stiffness κ carries this many times the input's largest pressure at half of ``dhat``
         (:func:`~skvalve.fem.contact.ipc.stiffness_for_pressure`): coapting leaflets then meet about ``dhat``/2 apart.
     exclude_within
-        body vertices closer than this (mm) in the reference never collide. 0: every pair that shares no vertex
-        collides. The 1.0 diseased valve has no pair within ``dhat`` at rest even so, and an excluded pair is one the
-        barrier and the collision-free step do not see: with 1 mm (the penalty contact's value, whose search depth
-        reached across a leaflet's two skins) the held load's steps folded the septal leaflet until one such edge pair,
-        0.53 mm apart in the reference, crossed, and every further step ran into it.
+        body vertices closer than this (mm) in the reference never collide: a leaflet's own skins and neighbours
+        where it folds sharply, at the chordae insertions and the commissures. An excluded pair is one the barrier and
+        the collision-free step do not see, so it can cross: on the 1.0 diseased valve's held load a settle step
+        crossed two edges of one free-edge hex (0.53 mm apart in the reference; the hex's smallest corner Jacobian
+        -5.4e-5: a folded corner). Without any exclusion the barrier held that corner and the settle stage went on, but
+        the posterior leaflet's papillary stage jammed (relative residual 1e7 at its sixth step, steps capped to 1e-3
+        of their length): the barrier is no guard against a folding element, and the element must resist it itself.
     friction
         ``None`` (frictionless; the 1.0 inputs' friction 0.001 is negligible) or a :class:`Friction`.
     check_intersections
@@ -67,7 +69,7 @@ class ContactOptions:
 
     dhat: float = 0.1
     pressure_factor: float = 2.0
-    exclude_within: float = 0.0
+    exclude_within: float = 1.0
     friction: Friction | None = None
     check_intersections: bool = True
 
