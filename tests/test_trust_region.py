@@ -479,3 +479,21 @@ def test_each_steps_energy_change_is_the_drop_of_the_total_potential():
     resolved = np.abs(drops) > 1e-8 * abs(energies[-1])
     assert resolved.sum() >= 5
     np.testing.assert_allclose(np.array(result.energy_changes)[resolved], drops[resolved], rtol=1e-9)
+
+
+@pytest.mark.skipif("pardiso" not in available_solvers(), reason="the inertia needs PARDISO")
+def test_newton_tries_are_not_held_to_a_shrunken_radius():
+    """Near the curled flap's equilibrium, with a radius of 1e-7 (as energy steps that keep being rejected leave it),
+    Newton's tries may still go as far as ``max_radius``: they are kept by the residual's fall, so the run converges
+    in a few tries, quadratically, instead of crawling 1e-7 at a time."""
+    newton = solve(_flap(), 10, progress=False, rtol=1e-10).u()
+    rng = np.random.default_rng(7)
+    flap = _flap()
+    start = newton + 1e-6 * np.abs(newton).max() * rng.standard_normal(newton.size)
+    start[flap.pattern.fixed] = newton[flap.pattern.fixed]
+    options = TrustRegionOptions(rtol=1e-10, radius=1e-7, min_radius=1e-9, max_radius=2.0, newton_below=10.0,
+                                 max_steps=8)
+    result = trust_region(flap, 1.0, start, options, progress=False)
+    assert result.converged and result.newton_steps == len(result.residuals) <= 6
+    assert max(result.largest_increments) > 50 * options.radius  # held to the radius it could not move so far
+    np.testing.assert_allclose(result.u, newton, atol=1e-8 * np.abs(newton).max())

@@ -40,8 +40,9 @@ collision primitives excluded from the barrier) is rejected as an inverted eleme
 A follower pressure on an open surface (leaflets with free edges) makes the problem non-conservative:
 near the equilibrium the work of its non-symmetric part is as large as the energy decrease the model predicts, and
 :math:`K_s` may stay indefinite at a stable state. Below ``newton_below`` each step first tries Newton's step with
-the full tangent (held to the radius) and keeps it when the residual norm falls to ``newton_decrease`` of its value:
-there the merit is the residual, whose root is the equilibrium whatever the symmetry. The residual is always the
+the full tangent (held to the largest radius, ``max_radius``) and keeps it when the residual norm falls to
+``newton_decrease`` of its value: there the merit is the residual, whose root is the equilibrium whatever the
+symmetry. The residual is always the
 undamped one: converged means :math:`\lVert R_f\rVert \le
 \max(\text{atol}, \text{rtol}\cdot f_\text{ref})` (the reactions' and loads' scale, as Newton).
 """
@@ -205,7 +206,10 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             K = problem.tangent_matrix(tangent)
             if relative <= opts.newton_below and (relative <= retry_below or step >= retry_after):
                 result.newton_tries += 1
-                tried = _newton_try(problem, solvers[2], K, residual, u, t, step, radius, norm, opts, result, limit)
+                # Newton's step may go as far as the largest radius: it is kept by the residual's fall, not by the
+                # model, and held to a radius the energy steps have shrunk it cannot halve the residual
+                tried = _newton_try(problem, solvers[2], K, residual, u, t, step, opts.max_radius, norm, opts,
+                                    result, limit)
                 if tried is None:
                     retry_below, retry_after = 0.5 * relative, step + 10
                     if verbose:
@@ -367,8 +371,9 @@ def _stalled(energy_changes: list[float], opts: TrustRegionOptions) -> bool:
 
 
 def _newton_try(problem, solver, K, residual, u, t, step, radius, norm, opts, result, limit):
-    """Newton's step with the full tangent, scaled into ``radius``: (step, residual, tangent, trapezoidal work,
-    largest nodal motion) when the residual norm falls below ``newton_decrease * norm``, else None (rewound)."""
+    """Newton's step with the full tangent, scaled into ``radius`` (the options' largest): (step, residual, tangent,
+    trapezoidal work, largest nodal motion) when the residual norm falls below ``newton_decrease * norm``, else None
+    (rewound)."""
     free, space = problem.pattern.free, problem.space
     clock = time.perf_counter()
     try:

@@ -53,7 +53,7 @@ class TrustRegionOptions:
         by ``local_decay`` (below ``min_shift``: zero). ``local_shift`` 0: off (every rejection halves the radius).
     newton_below, newton_decrease : float
         Below the relative residual ``newton_below`` (0: never) a step is first tried as Newton's with the full
-        tangent, scaled into the radius, and kept when the residual norm falls below ``newton_decrease`` times its
+        tangent, scaled into ``max_radius``, and kept when the residual norm falls below ``newton_decrease`` times its
         value (module docstring); a failed try is rewound and not repeated until the residual has halved or ten steps
         have passed.
     fit_radius : int
