@@ -120,14 +120,7 @@ class IncrementalOptions:
 
 
 class StepFailed(Exception):
-    """A load step whose minimisation did not converge (the caller rewinds and cuts the step back).
-
-    ``last``: when it ran out of iterations, its last iterate ``(u, static residual, history)`` (every iterate
-    lowered the step's merit, so a caller that only needs progress may keep it; None otherwise)."""
-
-    def __init__(self, message: str, last: tuple[np.ndarray, np.ndarray, list[dict]] | None = None) -> None:
-        super().__init__(message)
-        self.last = last
+    """A load step whose minimisation did not converge (the caller rewinds and cuts the step back)."""
 
 
 def projected_tangent(problem: Problem, tangent: Tangent) -> sp.csr_matrix:
@@ -327,7 +320,7 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
                         "relative_residual": float(np.linalg.norm(gradient[free])) / reference,
                         "seconds": time.perf_counter() - clock})
     raise StepFailed(f"no convergence in {opts.max_iter} iterations (relative residual "
-                     f"{float(np.linalg.norm(gradient[free])) / scale(residual):.3e})", last=(u, residual, history))
+                     f"{float(np.linalg.norm(gradient[free])) / scale(residual):.3e})")
 
 
 @dataclass
