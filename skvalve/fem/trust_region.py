@@ -284,12 +284,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                 trial_energy = problem.potential_energy(u + p, t, skip=work_terms)
             except (NonPositiveJacobianError, _Attempt) as err:
                 result.timings["assembly"] += time.perf_counter() - clock
-                problem.rewind()
-                result.rejected += 1
-                radius = 0.5 * largest
-                logger.info("trust-region step %d rejected: %s", step, err)
-                if verbose:
-                    print(f"  rejected step {step}: {err}; radius {radius:.3g}", flush=True)
+                radius = _reject(problem, result, step, largest, err, verbose)
                 continue
             result.timings["assembly"] += time.perf_counter() - clock
             nodal_work = _nodal_work(residual, middle, trial_residual, p, free, space)  # where the energy went
@@ -305,12 +300,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                 except StateRefused as err:
                     refused = err
             if refused is not None:
-                problem.rewind()
-                result.rejected += 1
-                radius = 0.5 * largest
-                logger.info("trust-region step %d rejected: %s", step, refused)
-                if verbose:
-                    print(f"  rejected step {step}: {refused}; radius {radius:.3g}", flush=True)
+                radius = _reject(problem, result, step, largest, refused, verbose)
                 continue
             if not (work < 0.0 and ratio >= opts.eta):
                 problem.rewind()
@@ -359,6 +349,19 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
     finally:
         bar.close()
     return result
+
+
+def _reject(problem: Problem, result: TrustRegionResult, step: int, largest: float, reason: Exception,
+            verbose: bool) -> float:
+    """Rewind a trial that failed before its energy decided (an inverted element, a non-finite residual, a refused
+    state), count it, and return the halved radius."""
+    problem.rewind()
+    result.rejected += 1
+    radius = 0.5 * largest
+    logger.info("trust-region step %d rejected: %s", step, reason)
+    if verbose:
+        print(f"  rejected step {step}: {reason}; radius {radius:.3g}", flush=True)
+    return radius
 
 
 def _stalled(energy_changes: list[float], opts: TrustRegionOptions) -> bool:

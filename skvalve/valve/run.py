@@ -260,7 +260,7 @@ class _Run:
                     raise ClosureFailed(f"{s.input}: held load not converged ({err}; the kept state is the last "
                                         "accepted step)") from err
                 result = None
-            s.u = s.u if result is None or result.u is None else result.u
+            s.u = s.u if result is None else result.u
             if result is not None and result.converged:
                 s.phase = "done"
                 residual, _ = self.problem.assemble(s.u, self.end, tangent=False)
