@@ -1,4 +1,5 @@
-"""The valve closure's model: the input's implicit model plus IPC contact on the leaflets' hex boundary.
+"""The valve closure's model: the input's implicit model, a barrier against folding hex corners
+(:class:`~skvalve.fem.corner_barrier.CornerBarrier`) and IPC contact on the leaflets' hex boundary.
 
 :func:`valve_setup` builds what :func:`skvalve.valve.run.close_valve` solves and what the outputs
 (:mod:`.outputs`, the mathur2022 figures) measure: the :class:`~skvalve.valve.model.ValveModel`, its
@@ -15,6 +16,7 @@ import numpy as np
 
 from ..fem.contact import IPCContact
 from ..fem.contact.ipc import stiffness_for_pressure
+from ..fem.corner_barrier import CornerBarrier
 from ..fem.damping import lumped_volume
 from ..fem.loads import FollowerPressure
 from ..fem.problem import Problem
@@ -51,6 +53,9 @@ def valve_setup(source: str | Path | AbaqusModel, options: CloseOptions | None =
     peak = max((abs(load.magnitude) for load in model.pressures), default=0.0)
     if peak <= 0.0:
         raise ValueError(f"{abaqus.path}: no pressure load; the closure needs the transvalvular pressure")
+    if options.model.corner_threshold > 0.0:
+        moduli = np.array([law.shear_modulus for law in model.laws])[model.regions]
+        problem.add_term(CornerBarrier(problem.space, moduli, options.model.corner_threshold))
     c = options.contact
     stiffness = stiffness_for_pressure(c.pressure_factor * peak, c.dhat, 0.5)
     contact = problem.add_term(IPCContact(problem.space, dhat=c.dhat, stiffness=stiffness,
