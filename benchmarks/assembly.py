@@ -2,17 +2,17 @@
 
 Part 1 — Gauss points per second of stress + tangent + element forces/stiffness on a block of
 trilinear hexahedra (8 points each), for every law the papers use, through the fused kernel of
-``skvalve.fem.fused`` and through the generic path (``law.pk1_and_tangent`` with
+``skvalve.fem.elements.fused`` and through the generic path (``law.pk1_and_tangent`` with
 ``kernels.element_forces/element_stiffness``), with their ratio in the same run; the two agree
 to 1e-12 (checked here on the first element too, fully in tests/test_fem_fused.py).
 
 Part 2 — one Newton iteration on the Texas TriValve 1.0 leaflets (Diseased_QuasiStatic.inp, the
 C3D8R leaflet elements with full 2x2x2 integration, the file's Lee–Sacks parameters per leaflet,
 annulus nodes fixed, a smooth trial displacement): assembly (F, fused stress/tangent/element
-matrices per leaflet, forces, CSR values) and the sparse solve of ``skvalve.fem.linsolve.LinearSolver``
+matrices per leaflet, forces, CSR values) and the sparse solve of ``skvalve.fem.solvers.linsolve.LinearSolver``
 (symmetric PARDISO; the analysis is done once per pattern, so the first solve also reports it).
 The generic assembly is timed too, and so is the F-bar term of the same leaflets
-(``skvalve.fem.fbar.FBarTerm``, residual + tangent) with P and dP/dF at F_bar from the compiled laws
+(``skvalve.fem.elements.fbar.FBarTerm``, residual + tangent) with P and dP/dF at F_bar from the compiled laws
 (``fused.point_response_regions``) against the generic ``MaterialRegions.evaluate``.
 Last line ``trivalve_iteration_seconds=<assembly + solve>``.
 Data: Texas TriValve (set ``SKVALVE_TRIVALVE`` or place it under shared/data); skipped if absent.
@@ -33,10 +33,10 @@ import scipy.sparse as sp
 import skfem as fem
 from skfem.io.meshio import from_meshio
 
-from skvalve.fem.fbar import FBarTerm
-from skvalve.fem.fused import fused_response
+from skvalve.fem.elements.fbar import FBarTerm
+from skvalve.fem.elements.fused import fused_response
 from skvalve.fem.kernels import csr_pattern, element_forces, element_gradients, element_stiffness, scatter_add
-from skvalve.fem.linsolve import LinearSolver
+from skvalve.fem.solvers.linsolve import LinearSolver
 from skvalve.fem.space import Space
 from skvalve.io.abaqus import read_model
 from skvalve.kinematics import determinant

@@ -25,7 +25,8 @@ import skfem as fem
 from scipy.optimize import brentq
 from skfem.io.meshio import to_meshio
 
-from skvalve.fem import Solid, linsolve
+from skvalve.fem import Solid
+from skvalve.fem.solvers import linsolve
 from skvalve.materials import NeoHookean
 
 STRETCH, STEPS, RTOL = 1.5, 5, 1e-8

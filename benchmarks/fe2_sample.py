@@ -29,7 +29,7 @@ import time
 import numba
 import numpy as np
 
-from skvalve.fem import linsolve
+from skvalve.fem.solvers import linsolve
 from skvalve.networks.rve import RVEBatch
 from skvalve.papers.thomas2019 import data
 from skvalve.papers.thomas2019.models import fe2_material

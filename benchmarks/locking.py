@@ -21,7 +21,7 @@ import numpy as np
 import skfem
 
 from skvalve.fem import FollowerPressure, Problem, Solid, Space, solve
-from skvalve.fem.fbar import FBarTerm
+from skvalve.fem.elements.fbar import FBarTerm
 from skvalve.materials import LeeSacks
 
 LEAFLET = LeeSacks(1.0e-3, 1.188659e-4, 15.260081, 20.0669)

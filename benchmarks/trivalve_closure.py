@@ -7,8 +7,8 @@ before and after (the machine may be shared), wall time, path and held steps, it
 residual, intersection, smallest corner Jacobian, contact pairs and where the time went, measured by wrapping the
 calls with timers (no profiler): each term's assembly and energy by term type, the tangent's sparse sum, CCD
 (``IPCContact.step_fraction``), the intersection checks and the collision counts of the step records, and the
-analysis, factorisation and solve of :class:`skvalve.fem.linsolve.LinearSolver`. Target for the 1.0 diseased valve
-from the open state: <= 1800 s on 2 cores. Needs the input (``$SKVALVE_TRIVALVE``; Mathur et al. 2022, CC BY-NC-SA
+analysis, factorisation and solve of :class:`skvalve.fem.solvers.linsolve.LinearSolver`. Target for the 1.0 diseased
+valve from the open state: <= 1800 s on 2 cores. Needs the input (``$SKVALVE_TRIVALVE``; Mathur et al. 2022, CC BY-NC-SA
 4.0); exits 2 without it.
 
 Last line: ``trivalve_closure_seconds=<x>`` (the wall time of the set-up and ``close_valve``).
@@ -23,7 +23,7 @@ import time
 from collections import defaultdict
 from pathlib import Path
 
-from skvalve.fem.linsolve import LinearSolver
+from skvalve.fem.solvers.linsolve import LinearSolver
 from skvalve.io.abaqus import trivalve_input
 from skvalve.valve.options import CloseOptions, HoldOptions
 from skvalve.valve.run import STATE_FILE, CloseReport, ClosureFailed, close_valve

@@ -32,7 +32,7 @@
 # | chordae law (3-term Ogden, uniaxial) | Eq. 2 | `skvalve.materials.uniaxial.OgdenUniaxial` |
 # | parameters as shipped in the input | Tables S1–S2 (supplement) | `skvalve.papers.mathur2022.data` |
 # | the valve: hexes, cables, conditions, pressure | Sects. 2.5–2.9 | `skvalve.valve.model.valve_model` |
-# | implicit quasi-static closure | Sect. 2.8 (explicit there) | `fem.newton.solve` (§3), `valve.run.close_valve` (§4) |
+# | implicit quasi-static closure | Sect. 2.8 (explicit there) | `fem.solvers.newton.solve` (§3), `valve.run.close_valve` (§4) |
 # | Tables 2–3 | Sect. 3.3 | `skvalve.valve.outputs`, `skvalve.papers.mathur2022.data` |
 #
 # Every number the text quotes is computed in a cell and checked there against a closed form or the paper. Units are
@@ -49,16 +49,16 @@ from scipy.optimize import brentq
 
 from skvalve.analytic.homogeneous import equibiaxial, uniaxial
 from skvalve.fem.amplitudes import GeometricRamp
-from skvalve.fem.constitutive import MaterialRegions
-from skvalve.fem.damping import DampingSchedule, ViscousDamping, undamped_residual
+from skvalve.fem.elements.constitutive import MaterialRegions
+from skvalve.fem.elements.fbar import FBarTerm
+from skvalve.fem.elements.truss import Truss
 from skvalve.fem.errors import SolverError
-from skvalve.fem.fbar import FBarTerm
 from skvalve.fem.fields import element_centres
 from skvalve.fem.loads import FollowerPressure
-from skvalve.fem.newton import solve
 from skvalve.fem.problem import Problem
+from skvalve.fem.solvers.damping import DampingSchedule, ViscousDamping, undamped_residual
+from skvalve.fem.solvers.newton import solve
 from skvalve.fem.space import Space
-from skvalve.fem.truss import Truss
 from skvalve.io.abaqus import read_model, trivalve_input
 from skvalve.materials.uniaxial import OgdenUniaxial, TensionOnly
 from skvalve.papers.mathur2022 import data as m22
@@ -610,14 +610,15 @@ if HAVE_DATA:
 # * `skvalve valve close FILE --out DIR` closes a whole valve input with the defaults of `skvalve.valve.options`
 #   (`skvalve.valve.run.close_valve`). Contact is the IPC barrier (`skvalve.fem.contact.IPCContact`) on the leaflets'
 #   whole hex boundary, on from the start. The load path follows the input's amplitudes (papillary motion, then the
-#   pressure) in incremental-potential steps (`skvalve.fem.incremental`) of adaptive length, each a minimisation by
-#   shifted Newton with a collision-free line search: every trial is cut to the share of the step that continuous
-#   collision detection finds free, so no iterate passes through a leaflet and no state needs repair. A viscous
-#   pseudo-mass holds the nodes that nothing else holds yet. At the held load an energy trust region
-#   (`skvalve.fem.trust_region`) takes over: steps of at most a millimetre on any node, accepted by the energy they
-#   release, first on the element-projected tangent until that drop stalls, then on the tangent itself with Newton's
-#   steps at the end, to a relative residual of 1e-6. The state is kept after every accepted step (`DIR/state.npz`,
-#   with `closure.log`; `closure.pvd` at the end), and `--resume` continues an interrupted run from it.
+#   pressure) in incremental-potential steps (`skvalve.fem.solvers.incremental`) of adaptive length, each a
+#   minimisation by shifted Newton with a collision-free line search: every trial is cut to the share of the step
+#   that continuous collision detection finds free, so no iterate passes through a leaflet and no state needs repair.
+#   A viscous pseudo-mass holds the nodes that nothing else holds yet. At the held load an energy trust region
+#   (`skvalve.fem.solvers.trust_region`) takes over: steps of at most a millimetre on any node, accepted by the
+#   energy they release, first on the element-projected tangent until that drop stalls, then on the tangent itself
+#   with Newton's steps at the end, to a relative residual of 1e-6. The state is kept after every accepted step
+#   (`DIR/state.npz`, with `closure.log`; `closure.pvd` at the end), and `--resume` continues an interrupted run
+#   from it.
 # * `skvalve reproduce mathur2022 --full --out out/` closes every Texas TriValve input present that way, each in
 #   `out/<key>` and resumed from the state kept there, and prints the Table 2–3 rows of each column with figures and
 #   a VTU/PVD series (the clip repair's rigid arms are moving IPC obstacles, its three steps in total time);

@@ -4,7 +4,7 @@ import numpy as np
 import skfem
 
 from skvalve.fem import Solid, Space
-from skvalve.fem.truss import Truss
+from skvalve.fem.elements.truss import Truss
 from skvalve.materials import NeoHookean
 
 

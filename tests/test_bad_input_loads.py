@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 
 from skvalve.fem import Solid, solve
-from skvalve.fem.damping import lumped_volume
 from skvalve.fem.errors import LoadError, SolverError
 from skvalve.fem.meshes import box
-from skvalve.fem.ptc import pseudo_transient
-from skvalve.fem.trust_region import trust_region
+from skvalve.fem.solvers.damping import lumped_volume
+from skvalve.fem.solvers.ptc import pseudo_transient
+from skvalve.fem.solvers.trust_region import trust_region
 from skvalve.materials import NeoHookean
 
 LAW = NeoHookean(1.0, 2.0)

@@ -8,9 +8,9 @@ from scipy.optimize import brentq
 
 from skvalve.analytic.homogeneous import uniaxial
 from skvalve.fem import Problem, Space, solve
-from skvalve.fem.constitutive import MaterialRegions
 from skvalve.fem.contact import ContactSurface, SurfaceContact, gap_derivatives, oriented_quads
-from skvalve.fem.hyperelastic import HyperelasticTerm
+from skvalve.fem.elements.constitutive import MaterialRegions
+from skvalve.fem.elements.hyperelastic import HyperelasticTerm
 from skvalve.materials import NeoHookean
 
 LAW = NeoHookean(1.0, 2.0)

@@ -12,9 +12,9 @@ from skvalve.fem import HyperelasticTerm, MaterialRegions, Problem, Space
 from skvalve.fem.contact import ContactSurface, SurfaceContact
 from skvalve.fem.contact.blend import free_edges
 from skvalve.fem.contact.clearance import clearance_fraction
-from skvalve.fem.damping import lumped_volume
-from skvalve.fem.ptc import PseudoTransientOptions, pseudo_transient
-from skvalve.fem.trust_region import TrustRegionOptions, trust_region
+from skvalve.fem.solvers.damping import lumped_volume
+from skvalve.fem.solvers.ptc import PseudoTransientOptions, pseudo_transient
+from skvalve.fem.solvers.trust_region import TrustRegionOptions, trust_region
 from skvalve.materials import NeoHookean
 
 GAP, PUSH, DEPTH = 0.2, 0.45, 0.1

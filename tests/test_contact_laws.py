@@ -18,7 +18,7 @@ from skvalve.fem.contact.blend import BARRIER_FLOOR
 from skvalve.fem.contact.clearance import ALLOWED_DEPTH, clearance_fraction
 from skvalve.fem.contact.laws import BARRIER_CUTOFF, depth_barrier, rounded_penalty
 from skvalve.fem.errors import ConvergenceError
-from skvalve.fem.trust_region import TrustRegionOptions, trust_region
+from skvalve.fem.solvers.trust_region import TrustRegionOptions, trust_region
 
 PENALTY, START, FLOOR, SATURATE = 3.0, 0.1, 0.4, 0.45
 CUTOFF = FLOOR - BARRIER_CUTOFF * (FLOOR - START)

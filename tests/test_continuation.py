@@ -8,7 +8,7 @@ from _truss_checks import two_blocks_with_chord, two_nodes
 
 from skvalve.fem import NodalForce, Problem, Solid, solve
 from skvalve.fem.amplitudes import GeometricRamp, smooth_step_polynomial
-from skvalve.fem.truss import Truss
+from skvalve.fem.elements.truss import Truss
 from skvalve.materials import NeoHookean
 from skvalve.materials.uniaxial import LinearUniaxial, TensionOnly
 

@@ -5,14 +5,14 @@ import numpy as np
 import pytest
 import skfem
 
-from skvalve.fem.constitutive import MaterialRegions
-from skvalve.fem.corner_barrier import CornerBarrier, _first_root, corner_barrier_phi, hex_corner_stencils
+from skvalve.fem.elements.constitutive import MaterialRegions
+from skvalve.fem.elements.corner_barrier import CornerBarrier, _first_root, corner_barrier_phi, hex_corner_stencils
+from skvalve.fem.elements.fbar import FBarTerm
 from skvalve.fem.errors import NonPositiveJacobianError, TangledMeshError
-from skvalve.fem.fbar import FBarTerm
 from skvalve.fem.loads import NodalForce
 from skvalve.fem.problem import Problem
+from skvalve.fem.solvers.trust_region import TrustRegionOptions, trust_region
 from skvalve.fem.space import Space
-from skvalve.fem.trust_region import TrustRegionOptions, trust_region
 from skvalve.materials import NeoHookean
 
 

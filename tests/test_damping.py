@@ -1,4 +1,4 @@
-"""Pseudo-transient viscous damping (skvalve.fem.damping): the damped solve ends at the undamped equilibrium
+"""Pseudo-transient viscous damping (skvalve.fem.solvers.damping): the damped solve ends at the undamped equilibrium
 of a statically determinate block, lags it by an amount that vanishes with the coefficient, and its
 residual and tangent are consistent."""
 
@@ -9,7 +9,7 @@ from scipy.optimize import brentq
 
 from skvalve.analytic.homogeneous import uniaxial
 from skvalve.fem import Solid
-from skvalve.fem.damping import DampingSchedule, ViscousDamping, lumped_volume, undamped_residual
+from skvalve.fem.solvers.damping import DampingSchedule, ViscousDamping, lumped_volume, undamped_residual
 from skvalve.materials import NeoHookean
 
 LAW = NeoHookean(1.0, 2.0)

@@ -6,7 +6,7 @@ import pytest
 import skfem
 
 from skvalve.fem import FollowerPressure, Problem, Solid, Space, solve
-from skvalve.fem.fbar import FBarTerm
+from skvalve.fem.elements.fbar import FBarTerm
 from skvalve.fem.meshes import box, distort
 from skvalve.materials import LeeSacks, NeoHookean, Ogden
 

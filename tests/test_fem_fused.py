@@ -1,4 +1,4 @@
-"""The fused kernel (skvalve.fem.fused) against the generic path: law.pk1_and_tangent + kernels."""
+"""The fused kernel (skvalve.fem.elements.fused) against the generic path: law.pk1_and_tangent + kernels."""
 
 from __future__ import annotations
 
@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import skfem as fem
 
-from skvalve.fem.constitutive import MaterialRegions
-from skvalve.fem.fused import MixedFields, assemble_regions, fused_response
+from skvalve.fem.elements.constitutive import MaterialRegions
+from skvalve.fem.elements.fused import MixedFields, assemble_regions, fused_response
 from skvalve.fem.kernels import element_forces, element_gradients, element_stiffness
 from skvalve.fem.space import Space
 from skvalve.kinematics import cofactor, determinant

@@ -7,9 +7,10 @@ from _truss_checks import two_blocks_with_chord
 from scipy.optimize import brentq
 
 from skvalve.analytic import homogeneous
-from skvalve.fem import ConvergenceError, NonPositiveJacobianError, Solid, newton
+from skvalve.fem import ConvergenceError, NonPositiveJacobianError, Solid
 from skvalve.fem.meshes import box, rectangle
 from skvalve.fem.problem import Problem
+from skvalve.fem.solvers import newton
 from skvalve.io.timeseries import TimeSeriesWriter
 from skvalve.materials import BimodularNeoHookean, IncompressibleNeoHookean, NeoHookean
 from skvalve.materials.uniaxial import LinearUniaxial, TensionOnly

@@ -1,11 +1,11 @@
-"""The solid term's compiled path (skvalve.fem.fused) equals its generic path, for every law, u and u/p, 3D and
+"""The solid term's compiled path (skvalve.fem.elements.fused) equals its generic path, for every law, u and u/p, 3D and
 plane strain — so the finite-difference tangent checks of test_fem_tangent.py cover both."""
 
 import numpy as np
 import pytest
 
 from skvalve.fem import Solid
-from skvalve.fem.fused import fused_response
+from skvalve.fem.elements.fused import fused_response
 from skvalve.fem.meshes import box, distort, rectangle
 from skvalve.materials import BimodularNeoHookean, IncompressibleNeoHookean, LeeSacks, NeoHookean, Ogden
 

@@ -5,9 +5,10 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from skvalve.fem import Solid, linsolve
-from skvalve.fem.constitutive import neo_hookean_response
+from skvalve.fem import Solid
+from skvalve.fem.elements.constitutive import neo_hookean_response
 from skvalve.fem.meshes import annulus_sector, box, distort, rectangle
+from skvalve.fem.solvers import linsolve
 from skvalve.materials import IncompressibleNeoHookean, NeoHookean, Ogden
 
 

@@ -1,4 +1,4 @@
-"""Pointwise P and A = dP/dF of the compiled laws (skvalve.fem.fused.point_response_regions, used by F-bar)
+"""Pointwise P and A = dP/dF of the compiled laws (skvalve.fem.elements.fused.point_response_regions, used by F-bar)
 against the generic numpy path MaterialRegions.evaluate (law.pk1_and_tangent), per law and per region."""
 
 from __future__ import annotations
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 import skfem as fem
 
-from skvalve.fem.constitutive import MaterialRegions
-from skvalve.fem.fused import fused_response, point_response_regions
+from skvalve.fem.elements.constitutive import MaterialRegions
+from skvalve.fem.elements.fused import fused_response, point_response_regions
 from skvalve.kinematics import determinant
 from skvalve.materials import BimodularNeoHookean, LeeSacks, NeoHookean, Ogden
 

@@ -1,4 +1,4 @@
-"""Descent directions and line search of the incremental-potential steps (:mod:`skvalve.fem.incremental`).
+"""Descent directions and line search of the incremental-potential steps (:mod:`skvalve.fem.solvers.incremental`).
 
 The shifted Newton direction: Newton's step where the tangent is positive definite, the smallest Marquardt shift of
 the sequence where it is not (checked against the eigenvalues), a quadratic rate near a stable minimum where the
@@ -13,8 +13,10 @@ import pytest
 import scipy.sparse as sp
 from test_ipc_contact import _block_over_obstacle  # the pressed block of the IPC tests
 
-from skvalve.fem import Solid, linsolve, solve
-from skvalve.fem.incremental import (
+from skvalve.fem import Solid, solve
+from skvalve.fem.meshes import box
+from skvalve.fem.solvers import linsolve
+from skvalve.fem.solvers.incremental import (
     FIRST_SHIFT,
     SHIFT_GROWTH,
     IncrementalOptions,
@@ -22,7 +24,6 @@ from skvalve.fem.incremental import (
     incremental_potential,
     shifted_newton,
 )
-from skvalve.fem.meshes import box
 from skvalve.materials import NeoHookean
 
 pytestmark = pytest.mark.skipif("pardiso" not in linsolve.available_solvers(), reason="needs PARDISO's inertia")

@@ -21,9 +21,9 @@ from skvalve.fem.contact import (
     stiffness_for_pressure,
 )
 from skvalve.fem.contact.ipc import Friction
-from skvalve.fem.incremental import IncrementalOptions, incremental_potential
 from skvalve.fem.meshes import box
-from skvalve.fem.ptc import PseudoTransientOptions, pseudo_transient
+from skvalve.fem.solvers.incremental import IncrementalOptions, incremental_potential
+from skvalve.fem.solvers.ptc import PseudoTransientOptions, pseudo_transient
 from skvalve.materials import NeoHookean
 
 MATERIAL = NeoHookean.from_shear_poisson(G=10.0, nu=0.3)

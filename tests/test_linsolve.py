@@ -1,4 +1,4 @@
-"""Sparse direct solves: analysis kept per pattern, factor reuse, backend choice (skvalve.fem.linsolve)."""
+"""Sparse direct solves: analysis kept per pattern, factor reuse, backend choice (skvalve.fem.solvers.linsolve)."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from packaging.requirements import Requirement
 
-from skvalve.fem import linsolve
-from skvalve.fem.linsolve import LinearSolver, SlowSolverWarning, SolverUnavailableError
+from skvalve.fem.solvers import linsolve
+from skvalve.fem.solvers.linsolve import LinearSolver, SlowSolverWarning, SolverUnavailableError
 
 BACKENDS = [name for name in linsolve.available_solvers() if name != "umfpack"]
 

@@ -1,4 +1,5 @@
-"""Pseudo-transient continuation (:mod:`skvalve.fem.ptc`): it converges to the undamped equilibrium that load-stepped
+"""Pseudo-transient continuation (:mod:`skvalve.fem.solvers.ptc`): it converges to the undamped equilibrium that
+load-stepped
 Newton or a closed form gives, its trust regions hold on every accepted step, and bad input fails clearly."""
 
 from dataclasses import replace
@@ -9,11 +10,11 @@ from _truss_checks import sheared_block, two_nodes
 from scipy.optimize import brentq
 
 from skvalve.fem import NodalForce, Problem, solve
-from skvalve.fem.damping import lumped_volume
+from skvalve.fem.elements.truss import Truss
 from skvalve.fem.errors import ConvergenceError
-from skvalve.fem.ptc import PseudoTransientOptions, _carriers, pseudo_transient
+from skvalve.fem.solvers.damping import lumped_volume
+from skvalve.fem.solvers.ptc import PseudoTransientOptions, _carriers, pseudo_transient
 from skvalve.fem.terms import Blocks, Contribution, Term
-from skvalve.fem.truss import Truss
 from skvalve.materials.uniaxial import OgdenUniaxial, TensionOnly
 
 

@@ -5,7 +5,7 @@ import pytest
 import skfem
 
 from skvalve.fem import NodalForce, Problem, Space, soft_modes
-from skvalve.fem.truss import Truss
+from skvalve.fem.elements.truss import Truss
 from skvalve.materials.uniaxial import LinearUniaxial
 
 N_BARS, MODULUS, AREA = 6, 3.0, 0.5  # unit rest lengths: spring constant k = E A / L = 1.5

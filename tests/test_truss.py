@@ -7,8 +7,8 @@ import skfem
 from _truss_checks import two_blocks_with_chord
 
 from skvalve.fem import NodalForce, Problem, Space, solve
-from skvalve.fem.truss import LawAssignment, Truss, bar_response
-from skvalve.fem.trust_steps import project_psd
+from skvalve.fem.elements.truss import LawAssignment, Truss, bar_response
+from skvalve.fem.solvers.trust_steps import project_psd
 from skvalve.materials import Ogden
 from skvalve.materials.uniaxial import LinearUniaxial, OgdenUniaxial, TensionOnly
 

@@ -7,7 +7,7 @@ import scipy.sparse as sp
 import skfem
 
 from skvalve.fem import Space
-from skvalve.fem.truss import BarEnd, Truss
+from skvalve.fem.elements.truss import BarEnd, Truss
 from skvalve.materials.uniaxial import LinearUniaxial, OgdenUniaxial, TensionOnly
 from skvalve.valve.chordae import insertion_patches
 

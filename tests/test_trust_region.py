@@ -1,4 +1,5 @@
-"""Energy trust-region Newton (:mod:`skvalve.fem.trust_region`): it ends where Newton and closed forms end, crosses a
+"""Energy trust-region Newton (:mod:`skvalve.fem.solvers.trust_region`): it ends where Newton and closed forms end,
+crosses a
 region of negative curvature to the stable equilibrium, measures the energy change exactly where it can, and fails
 clearly."""
 
@@ -12,13 +13,12 @@ from _truss_checks import sheared_block
 from scipy.optimize import brentq
 
 from skvalve.fem import HyperelasticTerm, MaterialRegions, NodalForce, Problem, Solid, Space, solve
-from skvalve.fem.block_relaxation import BlockRelaxation
+from skvalve.fem.elements.truss import Truss
 from skvalve.fem.errors import ConvergenceError, StateRefused
-from skvalve.fem.linsolve import LinearSolver, available_solvers
 from skvalve.fem.loads import FollowerPressure
-from skvalve.fem.terms import Contribution, Term
-from skvalve.fem.truss import Truss
-from skvalve.fem.trust_region import (
+from skvalve.fem.solvers.block_relaxation import BlockRelaxation
+from skvalve.fem.solvers.linsolve import LinearSolver, available_solvers
+from skvalve.fem.solvers.trust_region import (
     TrustRegionOptions,
     fitted_shift,
     project_psd,
@@ -27,7 +27,8 @@ from skvalve.fem.trust_region import (
     trust_region,
     work_along,
 )
-from skvalve.fem.trust_steps import shift_psd
+from skvalve.fem.solvers.trust_steps import shift_psd
+from skvalve.fem.terms import Contribution, Term
 from skvalve.materials import NeoHookean
 from skvalve.materials.uniaxial import OgdenUniaxial, TensionOnly
 

@@ -12,7 +12,7 @@ import pytest
 from skvalve.fem import Solid
 from skvalve.fem.contact import IPCContact
 from skvalve.fem.meshes import box
-from skvalve.fem.newton import solve
+from skvalve.fem.solvers.newton import solve
 from skvalve.materials import NeoHookean
 from skvalve.valve import run as run_module
 from skvalve.valve.history import StepWindow

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from skvalve.fem.newton import solve
+from skvalve.fem.solvers.newton import solve
 from skvalve.io.abaqus import read_model, trivalve_inputs
 from skvalve.valve.links import LINK_FACTOR
 from skvalve.valve.model import valve_model

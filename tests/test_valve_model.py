@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from skvalve.fem import FollowerPressure
-from skvalve.fem.truss import LawAssignment
+from skvalve.fem.elements.truss import LawAssignment
 from skvalve.io.abaqus import HEX_FACE_NODES, read_model, trivalve_inputs
 from skvalve.materials.uniaxial import TensionOnly
 from skvalve.valve.chordae import collapse_chains, tangent_on_free_nodes

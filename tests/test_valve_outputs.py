@@ -10,7 +10,7 @@ import skfem
 from skvalve.fem import Solid
 from skvalve.fem.contact import IPCContact
 from skvalve.fem.meshes import box
-from skvalve.fem.newton import StepEvent
+from skvalve.fem.solvers.newton import StepEvent
 from skvalve.materials import NeoHookean
 from skvalve.valve.outputs import ClosureWriter, max_principal_cauchy
 from skvalve.valve.setup import ValveSetup

@@ -7,7 +7,7 @@ import pytest
 
 from skvalve.cli import main
 from skvalve.fem.contact.ipc import Friction
-from skvalve.fem.trust_region import TrustRegionControl
+from skvalve.fem.solvers.trust_region import TrustRegionControl
 from skvalve.valve.options import CloseOptions, ContactOptions, HoldOptions, ModelOptions, StepOptions
 from skvalve.valve.state import FORMAT, KeptState, StateError, read_state, write_state
 

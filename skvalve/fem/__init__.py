@@ -10,11 +10,13 @@ Typical use::
 
 :class:`Solid` is a :class:`Problem` with a :class:`HyperelasticTerm`; any other term (trusses,
 contact, constraints) joins with :meth:`Problem.add_term`, and :func:`solve` is the Newton driver.
-See ``docs/fem.md``. Derivations are in the module docstrings: :mod:`.hyperelastic` (weak form),
-:mod:`.constitutive` (mixed u/p), :mod:`.loads` (follower pressure), :mod:`.newton`.
+See ``docs/fem.md``. Derivations are in the module docstrings: :mod:`.elements.hyperelastic` (weak
+form), :mod:`.elements.constitutive` (mixed u/p), :mod:`.loads` (follower pressure), :mod:`.solvers.newton`. The
+element terms are in :mod:`.elements`, the solvers in :mod:`.solvers`, contact in :mod:`.contact`.
 """
 
-from .constitutive import MaterialRegions
+from .elements.constitutive import MaterialRegions
+from .elements.hyperelastic import HyperelasticTerm
 from .errors import (
     ConvergenceError,
     NonPositiveJacobianError,
@@ -23,14 +25,13 @@ from .errors import (
     SolverError,
     TangledMeshError,
 )
-from .hyperelastic import HyperelasticTerm
-from .linsolve import SolverUnavailableError, available_solvers, solver_name
 from .loads import FollowerPressure, NodalForce
-from .newton import StepEvent, solve
 from .problem import Problem
 from .result import Result
-from .soft_modes import SoftModes, soft_modes
 from .solid import Solid
+from .solvers.linsolve import SolverUnavailableError, available_solvers, solver_name
+from .solvers.newton import StepEvent, solve
+from .solvers.soft_modes import SoftModes, soft_modes
 from .space import Space
 from .taylor import TermTaylor, taylor_test
 from .terms import Blocks, Contribution, Term

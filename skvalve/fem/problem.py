@@ -1,6 +1,6 @@
 r"""A problem: one displacement (and pressure) field, Dirichlet constraints and a sum of terms.
 
-The Newton driver (:mod:`skvalve.fem.newton`) sees only this class's small protocol:
+The Newton driver (:mod:`skvalve.fem.solvers.newton`) sees only this class's small protocol:
 :meth:`Problem.assemble` (residual and a :class:`Tangent`), :meth:`Problem.constrained`,
 :meth:`Problem.commit` and :meth:`Problem.rewind`. Reactions are the residual at the constrained
 dofs, :math:`r = f_\text{int} - f_\text{ext}`: the force the supports exert on the body.
@@ -231,8 +231,8 @@ class Problem:
 
         ``blocks(term, matrices) -> matrices`` and ``matrix(term, sparse) -> sparse``, when given, replace each term's
         element blocks and extra matrix before they are added (e.g. their symmetric parts, or blocks projected onto
-        positive semidefinite ones: :func:`skvalve.fem.trust_region.step_matrix`). ``projected``: a term's blocks and
-        extra matrix are replaced by its own PSD projections where it gives them (``Blocks.projected``,
+        positive semidefinite ones: :func:`skvalve.fem.solvers.trust_region.step_matrix`). ``projected``: a term's
+        blocks and extra matrix are replaced by its own PSD projections where it gives them (``Blocks.projected``,
         ``Contribution.projected_matrix``).
         """
         pat = self.pattern

@@ -10,10 +10,10 @@ Dirichlet boundary such that for all admissible :math:`\delta u`
                   + \int_{\Gamma_p} p\,(\operatorname{cof}F\,N)\cdot\delta u\,dA
                   - \sum_n f_n\cdot\delta u(X_n) = 0,\qquad F = I + \nabla_0 u .
 
-Each of the three integrals is a term (:class:`~skvalve.fem.hyperelastic.HyperelasticTerm`,
+Each of the three integrals is a term (:class:`~skvalve.fem.elements.hyperelastic.HyperelasticTerm`,
 :class:`~skvalve.fem.loads.FollowerPressure`, :class:`~skvalve.fem.loads.NodalForce`); more terms
 (trusses, contact, constraints) are added with :meth:`Problem.add_term`. The mixed u/p terms are in
-:mod:`skvalve.fem.constitutive`, the follower-pressure load stiffness in :mod:`skvalve.fem.loads`.
+:mod:`skvalve.fem.elements.constitutive`, the follower-pressure load stiffness in :mod:`skvalve.fem.loads`.
 Plane strain (2D meshes) gives quantities per unit width.
 """
 
@@ -23,11 +23,11 @@ import numpy as np
 import skfem as fem
 
 from ..materials.base import Hyperelastic
-from .constitutive import MaterialRegions
-from .hyperelastic import HyperelasticTerm
+from .elements.constitutive import MaterialRegions
+from .elements.hyperelastic import HyperelasticTerm
 from .loads import FollowerPressure, NodalForce
-from .newton import solve
 from .problem import Problem
+from .solvers.newton import solve
 from .space import Space
 
 __all__ = ["Solid"]
@@ -95,5 +95,5 @@ class Solid(Problem):
         return self.solid.deformation_gradient(u)
 
     def solve(self, steps=10, **options):
-        """Load-controlled Newton–Raphson; see :func:`skvalve.fem.newton.solve` for options."""
+        """Load-controlled Newton–Raphson; see :func:`skvalve.fem.solvers.newton.solve` for options."""
         return solve(self, steps, **options)

@@ -15,10 +15,10 @@ Terms holding state (warm-started RVEs, active contact sets) accept it in :meth:
 a converged load step and restore it in :meth:`Term.rewind` after a failed attempt.
 
 Three optional hooks serve contact that must never pass through (:mod:`skvalve.fem.contact.ipc`) and steps solved as
-minimisations (:mod:`skvalve.fem.incremental`): :meth:`Term.step_fraction` caps a trial step (every solver calls it
-before it evaluates a trial state), :meth:`Term.check_state` vets an accepted state (e.g. no intersection, in debug
-runs and tests), and :meth:`Term.energy` gives the term's potential :math:`\Pi_k` with
-:math:`\partial\Pi_k/\partial u = f^\text{int}_k - f^\text{ext}_k`, or ``None`` where the term is not conservative.
+minimisations (:mod:`skvalve.fem.solvers.incremental`): :meth:`Term.step_fraction` caps a trial step (every solver calls
+it before it evaluates a trial state), :meth:`Term.check_state` vets an accepted state (e.g. no intersection, in debug
+runs and tests), and :meth:`Term.energy` gives the term's potential :math:`\Pi_k` with :math:`\partial\Pi_k/\partial u =
+f^\text{int}_k - f^\text{ext}_k`, or ``None`` where the term is not conservative.
 """
 
 from __future__ import annotations

@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fem.newton import StepEvent
 from ..fem.problem import Problem
+from ..fem.solvers.newton import StepEvent
 from .files import replace_atomically
 
 __all__ = ["Checkpoint", "latest", "resume"]

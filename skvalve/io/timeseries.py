@@ -20,7 +20,7 @@ import meshio
 import numpy as np
 
 from ..fem.fields import element_centres
-from ..fem.newton import StepEvent
+from ..fem.solvers.newton import StepEvent
 from .files import replace_atomically
 
 __all__ = ["TimeSeriesWriter", "step_fields"]

@@ -1,4 +1,4 @@
-r"""Scalar derivatives a law hands to the compiled assembly kernel (:mod:`skvalve.fem.fused`).
+r"""Scalar derivatives a law hands to the compiled assembly kernel (:mod:`skvalve.fem.elements.fused`).
 
 A law states its strain energy in a few scalar arguments; the tensor algebra that turns their
 derivatives into the stress, the tangent and the element matrices is written once in the kernel.

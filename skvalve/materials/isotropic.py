@@ -104,6 +104,7 @@ class IsotropicInvariantLaw(Hyperelastic):
         return S, CC
 
     def invariant_derivatives(self, I1bar: Array, J: Array, C: Array) -> InvariantDerivatives:
-        r"""The partials of :meth:`partials` for the compiled kernel (:mod:`skvalve.fem.fused`); no :math:`I_4`."""
+        r"""The partials of :meth:`partials` for the compiled kernel (:mod:`skvalve.fem.elements.fused`); no
+        :math:`I_4`."""
         p = self.partials(I1bar, J, C)
         return InvariantDerivatives(p.d_I, p.d_J, p.d_II, p.d_IJ, p.d_JJ)

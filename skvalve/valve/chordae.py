@@ -2,7 +2,7 @@ r"""Chordae tendineae as cables an implicit solver can carry: chains collapsed b
 
 The shipped chordae are polylines of 2-node trusses. A node that only joins two bars of a chain has
 no stiffness across the chain until the chain is in tension (the truss tangent across a bar is
-:math:`N/l`, :mod:`skvalve.fem.truss`), so each such node is a mechanism of the implicit tangent;
+:math:`N/l`, :mod:`skvalve.fem.elements.truss`), so each such node is a mechanism of the implicit tangent;
 a node hanging on one bar is a mechanism in every direction. Here the network is reduced to
 
 * **kept nodes**: nodes anchored to the rest of the model (leaflet nodes, nodes with boundary
@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..fem.truss import BarEnd, LawAssignment, bar_response
+from ..fem.elements.truss import BarEnd, LawAssignment, bar_response
 
 __all__ = ["CollapsedChordae", "collapse_chains", "tangent_on_free_nodes", "insertion_patches"]
 
@@ -199,7 +199,7 @@ def insertion_patches(cells: np.ndarray, points: np.ndarray, ends: np.ndarray, r
         L' = L + \big(|X'_b - X'_a| - |X_b - X_a|\big), \qquad \lambda'_s = |X'_b - X'_a| / L'.
 
     Parameters: ``cells`` (n_nodes_per_cell, n_cells), ``points`` (3, n_vertices), cable ``ends`` (n, 2),
-    ``rest_length`` (n,). Returns the two :class:`~skvalve.fem.truss.BarEnd`, the new rest lengths and the
+    ``rest_length`` (n,). Returns the two :class:`~skvalve.fem.elements.truss.BarEnd`, the new rest lengths and the
     slack stretches.
     """
     n_vertices = points.shape[1]

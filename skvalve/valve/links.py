@@ -9,8 +9,8 @@ prescribed displacements.
 Choice: a penalty, not an exact constraint
 ------------------------------------------
 The constraint :math:`|x_a - x_p| = L` is nonlinear, so it cannot be eliminated like a prescribed
-displacement, and the Newton solver (:mod:`skvalve.fem.newton`) has no Lagrange multipliers. Each link
-is therefore a :class:`~skvalve.fem.truss.Truss` bar with the linear law
+displacement, and the Newton solver (:mod:`skvalve.fem.solvers.newton`) has no Lagrange multipliers. Each link
+is therefore a :class:`~skvalve.fem.elements.truss.Truss` bar with the linear law
 :class:`~skvalve.materials.uniaxial.LinearUniaxial`, energy
 
 .. math::
@@ -43,8 +43,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..fem.elements.truss import Truss
 from ..fem.space import Space
-from ..fem.truss import Truss
 from ..io.abaqus import AbaqusModel, Location
 from ..materials.uniaxial import LinearUniaxial
 
@@ -74,7 +74,7 @@ class Links:
         return np.linalg.norm(x[self.ends[:, 1]] - x[self.ends[:, 0]], axis=1) / self.length - 1.0
 
     def term(self, space: Space) -> Truss:
-        """The penalty bars as a :class:`~skvalve.fem.truss.Truss` term (unit area, modulus :math:`EA`)."""
+        """The penalty bars as a :class:`~skvalve.fem.elements.truss.Truss` term (unit area, modulus :math:`EA`)."""
         return Truss(space, self.ends, 1.0, LinearUniaxial(self.rigidity), rest_length=self.length, name="links")
 
     def subset(self, new_index: np.ndarray) -> Links:

@@ -6,7 +6,7 @@ r"""A whole-valve model for the implicit solver, built from an Abaqus input (Tex
   1.1 inputs extruded into ``layers`` hexes through the section thickness (:mod:`.extrude`); one
   ``LeeSacks`` law per leaflet from the ``VUANISO_ISO`` properties :math:`(C_0, D, C_1, C_2)`
   (mathur2022 Eq. 1 as shipped, :class:`~skvalve.materials.LeeSacks`). They run on the F-bar
-  (mean-dilatation) hexahedron :class:`~skvalve.fem.fbar.FBarTerm`, which does not lock at the
+  (mean-dilatation) hexahedron :class:`~skvalve.fem.elements.fbar.FBarTerm`, which does not lock at the
   leaflets' :math:`\nu \approx 0.495`; ``solid="q1"`` gives the locking full-integration hexahedron
   for comparison;
 * **chordae**: the T3D2 trusses with their section area and the 3-term Ogden law in uniaxial stress,
@@ -40,15 +40,15 @@ from dataclasses import dataclass, field
 import numpy as np
 import skfem
 
-from ..fem.constitutive import MaterialRegions
 from ..fem.contact.obstacles import Obstacle
+from ..fem.elements.constitutive import MaterialRegions
+from ..fem.elements.fbar import FBarTerm
+from ..fem.elements.hyperelastic import HyperelasticTerm
+from ..fem.elements.truss import Truss
 from ..fem.errors import TangledMeshError
-from ..fem.fbar import FBarTerm
-from ..fem.hyperelastic import HyperelasticTerm
 from ..fem.loads import FollowerPressure
 from ..fem.problem import Problem
 from ..fem.space import Space
-from ..fem.truss import Truss
 from ..io.abaqus import HEX_FACE_NODES, AbaqusModel
 from ..materials import LeeSacks
 from ..materials.uniaxial import OgdenUniaxial, TensionOnly

@@ -32,9 +32,9 @@ class ModelOptions:
         the cables that are one input truss carry their law in compression too, as the input's truss
         elements do (a chordae branch point is then held by struts, not by slack springs).
     corner_threshold
-        the leaflet hexes resist a folding corner: :class:`~skvalve.fem.corner_barrier.CornerBarrier` acts where a
-        corner's Jacobian falls below this share of its reference value (0: off). A trilinear hex can fold at a
-        corner while its Gauss points stay positive; on the 1.0 diseased valve's held load one free-edge hex did
+        the leaflet hexes resist a folding corner: :class:`~skvalve.fem.elements.corner_barrier.CornerBarrier` acts
+        where a corner's Jacobian falls below this share of its reference value (0: off). A trilinear hex can fold
+        at a corner while its Gauss points stay positive; on the 1.0 diseased valve's held load one free-edge hex did
         (corner ratio -0.007). 0.1: at the converged state of that valve (without the barrier) 6 of its 151 360
         corners lay below 0.1 and 84 below 0.3, so the barrier changes the solution only where a corner degenerates.
     """
@@ -150,9 +150,9 @@ class StepOptions:
 
 @dataclass(frozen=True)
 class HoldOptions:
-    r"""The held load at the end time: the energy trust region (:func:`~skvalve.fem.trust_region.trust_region`), every
-    accepted step a kept state, the chordae branch points brought to equilibrium after each (block relaxation), in two
-    stages (:func:`~skvalve.valve.run.held_stages`):
+    r"""The held load at the end time: the energy trust region
+    (:func:`~skvalve.fem.solvers.trust_region.trust_region`), every accepted step a kept state, the chordae branch
+    points brought to equilibrium after each (block relaxation), in two stages (:func:`~skvalve.valve.run.held_stages`):
 
     1. *descend*: steps on the element-projected tangent under Marquardt's diagonal shift, up to ``max_radius`` on any
        node, until their energy drop stalls (the last 20 steps' average below ``stall_fraction`` of the stage's);

@@ -36,7 +36,7 @@ import scipy.sparse as sp
 
 from ..fem.contact import IPCContact
 from ..fem.fields import element_centres
-from ..fem.newton import StepEvent
+from ..fem.solvers.newton import StepEvent
 from ..io.abaqus.elements import is_shell_like
 from ..io.files import replace_atomically
 from .geometry import annulus_nodes, leaflet_surfaces, valve_areas

@@ -8,11 +8,12 @@ the collision-free share (continuous collision detection), so no iterate passes 
 repair afterwards.
 
 Path (:class:`~skvalve.valve.options.StepOptions`): incremental-potential steps
-(:func:`~skvalve.fem.incremental.minimise_step`) with a viscous pseudo-mass :math:`cV_i/\Delta t`, whose length
+(:func:`~skvalve.fem.solvers.incremental.minimise_step`) with a viscous pseudo-mass :math:`cV_i/\Delta t`, whose length
 grows after easy steps and halves after failed ones. The line search's merit is the incremental potential plus the
 follower pressure's work along the ray, by the trapezoidal rule (the pressure on the leaflets' open surface has no
 potential). Held load (:class:`~skvalve.valve.options.HoldOptions`, :func:`held_stages`): the energy trust region
-(:func:`~skvalve.fem.trust_region.trust_region`) at the end time, a *descend* stage of projected steps of up to a
+(:func:`~skvalve.fem.solvers.trust_region.trust_region`) at the end time, a *descend* stage of projected steps of up to
+a
 millimetre until their energy drop stalls, then a *settle* stage on the symmetric tangent with Newton's steps at
 the end, to ``rtol`` (1e-6) of the undamped problem; the chordae branch points are relaxed after every step.
 
@@ -33,12 +34,12 @@ from typing import NamedTuple
 import numpy as np
 from tqdm.auto import tqdm
 
-from ..fem import linsolve
-from ..fem.block_relaxation import BlockRelaxation
+from ..fem.elements.truss import Truss
 from ..fem.errors import ConvergenceError, NonPositiveJacobianError, SingularSystemError, SolverError
-from ..fem.incremental import IncrementalOptions, StepFailed, minimise_step
-from ..fem.truss import Truss
-from ..fem.trust_region import TrustRegionOptions, TrustRegionStep, trust_region
+from ..fem.solvers import linsolve
+from ..fem.solvers.block_relaxation import BlockRelaxation
+from ..fem.solvers.incremental import IncrementalOptions, StepFailed, minimise_step
+from ..fem.solvers.trust_region import TrustRegionOptions, TrustRegionStep, trust_region
 from ..io.abaqus import AbaqusModel
 from ..io.files import replace_atomically
 from .options import CloseOptions, HoldOptions
@@ -291,7 +292,7 @@ def held_stages(options: HoldOptions, load_norm: float, solver: str | None = Non
 
 def hub_relaxation(setup: ValveSetup) -> BlockRelaxation | None:
     """The chordae branch points (vertices of no leaflet cell, not prescribed) brought to equilibrium by the cables
-    alone with the rest held (:mod:`skvalve.fem.block_relaxation`): a global step that sees a hub's slack side
+    alone with the rest held (:mod:`skvalve.fem.solvers.block_relaxation`): a global step that sees a hub's slack side
     overshoots it, and unbalanced hubs would carry the residual (on the 1.0 diseased valve's held load, without it, 50
     hub nodes carried 96 % of the residual's square after 30 steps). None when the model has none."""
     problem = setup.problem

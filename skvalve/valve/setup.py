@@ -1,5 +1,5 @@
 """The valve closure's model: the input's implicit model, a barrier against folding hex corners
-(:class:`~skvalve.fem.corner_barrier.CornerBarrier`) and IPC contact on the leaflets' hex boundary.
+(:class:`~skvalve.fem.elements.corner_barrier.CornerBarrier`) and IPC contact on the leaflets' hex boundary.
 
 :func:`valve_setup` builds what :func:`skvalve.valve.run.close_valve` solves and what the outputs
 (:mod:`.outputs`, the mathur2022 figures) measure: the :class:`~skvalve.valve.model.ValveModel`, its
@@ -16,10 +16,10 @@ import numpy as np
 
 from ..fem.contact import IPCContact
 from ..fem.contact.ipc import stiffness_for_pressure
-from ..fem.corner_barrier import CornerBarrier
-from ..fem.damping import lumped_volume
+from ..fem.elements.corner_barrier import CornerBarrier
 from ..fem.loads import FollowerPressure
 from ..fem.problem import Problem
+from ..fem.solvers.damping import lumped_volume
 from ..io.abaqus import AbaqusModel, read_model
 from .extrude import hex_corner_jacobians
 from .model import ABAQUS_TO_SKFEM_HEX, ValveModel, valve_model

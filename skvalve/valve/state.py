@@ -2,7 +2,7 @@
 
 One ``.npz`` file (written atomically, :func:`~skvalve.io.files.replace_atomically`) with the step time, the
 displacement, the step controller (next step length, step count, held steps, the held stage and its trust region's
-:class:`~skvalve.fem.trust_region.TrustRegionControl`), the name of the input, the run's
+:class:`~skvalve.fem.solvers.trust_region.TrustRegionControl`), the name of the input, the run's
 :class:`~skvalve.valve.options.CloseOptions` as JSON, and every stateful term's committed state
 (:meth:`~skvalve.fem.problem.Problem.state`: the IPC barrier's stiffness and friction lag). A run resumed from it
 repeats the uninterrupted one (same steps, same iterates).
@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fem.trust_region import TrustRegionControl
+from ..fem.solvers.trust_region import TrustRegionControl
 from ..io.files import replace_atomically
 from .options import CloseOptions
 

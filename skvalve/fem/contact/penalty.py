@@ -5,7 +5,7 @@ Choice and why
 A penalty node-to-surface method (own code, search by :class:`scipy.spatial.cKDTree`), not the IPC barrier
 of ``ipctk`` (which installs here): IPC keeps every Newton iterate intersection-free only with a
 continuous-collision-detection limit on each line-search step, and the solver's line search
-(:mod:`skvalve.fem.newton`) has no hook for a term to cap the step; its barrier also acts at a positive
+(:mod:`skvalve.fem.solvers.newton`) has no hook for a term to cap the step; its barrier also acts at a positive
 distance :math:`\hat d` with an adaptively raised stiffness, which changes the problem between load steps.
 A penalty term needs nothing from the solver beyond the :class:`~skvalve.fem.terms.Term` protocol; its
 price is a penetration :math:`p/\varepsilon` that shrinks with the penalty :math:`\varepsilon`.

@@ -57,9 +57,9 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from numba import njit, prange
 
-from ..kinematics import cofactor, determinant
-from ..materials.base import Hyperelastic, VolumetricEnergy
-from ..materials.neo_hookean import NeoHookean
+from ...kinematics import cofactor, determinant
+from ...materials.base import Hyperelastic, VolumetricEnergy
+from ...materials.neo_hookean import NeoHookean
 
 __all__ = ["Region", "MaterialRegions", "neo_hookean_response"]
 

@@ -1,4 +1,5 @@
-r"""The step of the energy trust region (:mod:`skvalve.fem.trust_region`): its matrix, its shift and its direction.
+r"""The step of the energy trust region (:mod:`skvalve.fem.solvers.trust_region`): its matrix, its shift and its
+direction.
 
 The step solves :math:`(H + \alpha D)\,p = -R_f` with :math:`H` the symmetric part of the tangent (element blocks
 optionally projected onto their positive semidefinite parts: Teran, Sifakis, Irving & Fedkiw 2005), :math:`D`
@@ -13,8 +14,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
+from ..problem import Problem, Tangent
 from . import linsolve
-from .problem import Problem, Tangent
 
 __all__ = ["project_psd", "shift_psd", "project_sparse_psd", "step_matrix", "fitted_shift", "fit_radius",
            "shifted_direction", "factorize_counted", "largest_motion", "on_all_dofs", "FIT_ABOVE"]

@@ -1,5 +1,5 @@
-"""The trust region's records (:func:`skvalve.fem.trust_region.trust_region`): its options, its controller between
-steps (what a resumed run needs), what a callback sees after each step, and the result."""
+"""The trust region's records (:func:`skvalve.fem.solvers.trust_region.trust_region`): its options, its controller
+between steps (what a resumed run needs), what a callback sees after each step, and the result."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .problem import Problem
+from ..problem import Problem
 
 __all__ = ["TrustRegionControl", "TrustRegionOptions", "TrustRegionResult", "TrustRegionStep"]
 
@@ -83,7 +83,7 @@ class TrustRegionOptions:
         runs one after the other, each from the state the one before ended at), e.g. projected steps that carry a
         structure a long way down its energy and no longer do once it is there.
     solver : str or None
-        Sparse backend (:func:`skvalve.fem.linsolve.solver_name`); PARDISO reports the inertia, SuperLU does not
+        Sparse backend (:func:`skvalve.fem.solvers.linsolve.solver_name`); PARDISO reports the inertia, SuperLU does not
         (then :math:`\alpha` rises only when a step is not a descent direction of the model).
     """
 

@@ -55,9 +55,9 @@ import numpy as np
 import scipy.sparse as sp
 import skfem as fem
 
-from .errors import NonPositiveJacobianError, TangledMeshError
-from .space import Space
-from .terms import Contribution, Term
+from ..errors import NonPositiveJacobianError, TangledMeshError
+from ..space import Space
+from ..terms import Contribution, Term
 
 __all__ = ["CornerBarrier", "corner_barrier_phi", "hex_corner_stencils"]
 

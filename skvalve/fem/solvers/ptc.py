@@ -40,10 +40,10 @@ import numpy as np
 import scipy.sparse as sp
 from tqdm.auto import tqdm
 
+from ..errors import ConvergenceError, NonPositiveJacobianError
+from ..problem import Problem
 from . import linsolve
-from .errors import ConvergenceError, NonPositiveJacobianError
 from .newton import reference_force
-from .problem import Problem
 from .ptc_options import PseudoTransientOptions
 
 __all__ = ["PseudoTransientOptions", "PseudoTransientStep", "PseudoTransientResult", "pseudo_transient"]
@@ -113,12 +113,12 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
                      limit: Callable[[np.ndarray, np.ndarray], float] | None = None) -> PseudoTransientResult:
     """Follow the load factor from ``t0`` to ``end`` and relax to the equilibrium at ``end`` (module docstring).
 
-    ``weights``: the diagonal :math:`M` (n_dofs,), e.g. :func:`~skvalve.fem.damping.lumped_volume`; dofs with zero
-    weight get no damping. ``edges``: (m, 2) node pairs (element edges, cables) watched by ``max_strain_increment``,
-    ``rest_lengths`` the lengths from which each carries tension (default: the reference lengths; for a cable, its
-    rest length). ``limit``: ``limit(u, du) -> f`` in (0, 1], the fraction of a pseudo-step's increment that may be
-    taken (e.g. :func:`~skvalve.fem.contact.clearance.clearance_fraction`); a step with ``f < 1`` is rejected and
-    ``dtau`` cut to ``max(0.1, 0.8 f)`` of itself (a pseudo-step's increment shrinks about as ``dtau``).
+    ``weights``: the diagonal :math:`M` (n_dofs,), e.g. :func:`~skvalve.fem.solvers.damping.lumped_volume`; dofs with
+    zero weight get no damping. ``edges``: (m, 2) node pairs (element edges, cables) watched by
+    ``max_strain_increment``, ``rest_lengths`` the lengths from which each carries tension (default: the reference
+    lengths; for a cable, its rest length). ``limit``: ``limit(u, du) -> f`` in (0, 1], the fraction of a pseudo-step's
+    increment that may be taken (e.g. :func:`~skvalve.fem.contact.clearance.clearance_fraction`); a step with ``f < 1``
+    is rejected and ``dtau`` cut to ``max(0.1, 0.8 f)`` of itself (a pseudo-step's increment shrinks about as ``dtau``).
     Returns a :class:`PseudoTransientResult` with ``converged`` set; raises
     :class:`~skvalve.fem.errors.ConvergenceError` / :class:`~skvalve.fem.errors.NonPositiveJacobianError` when the
     step falls below ``min_step`` or ``max_steps`` pass (``error.last_state``: the last accepted result).

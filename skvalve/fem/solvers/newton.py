@@ -46,10 +46,10 @@ import numpy as np
 import scipy.sparse as sp
 from tqdm.auto import tqdm
 
+from ..errors import ConvergenceError, NonPositiveJacobianError, OutputError, SingularSystemError, SolverError
+from ..problem import Problem
+from ..result import Result
 from . import linsolve
-from .errors import ConvergenceError, NonPositiveJacobianError, OutputError, SingularSystemError, SolverError
-from .problem import Problem
-from .result import Result
 
 __all__ = ["solve", "StepEvent", "NewtonOptions"]
 

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from .problem import Problem
+from ..problem import Problem
 
 __all__ = ["SoftModes", "soft_modes"]
 

@@ -45,14 +45,14 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ..kinematics import determinant
+from ...kinematics import determinant
+from ..errors import NonPositiveJacobianError
+from ..kernels import add_point_stiffness, element_gradients
+from ..space import Space
+from ..terms import Blocks, Contribution, Term
 from .constitutive import MaterialRegions
-from .errors import NonPositiveJacobianError
 from .fused import point_response_regions
 from .fused_points import inverse_transpose
-from .kernels import add_point_stiffness, element_gradients
-from .space import Space
-from .terms import Blocks, Contribution, Term
 
 __all__ = ["FBarTerm", "mean_dilatation", "fbar_deformation", "fbar_element_response"]
 
@@ -189,11 +189,12 @@ class FBarTerm(Term):
     ----------
     space : the field's :class:`~skvalve.fem.space.Space` (hex mesh, ``formulation="u"``, ``order=1``).
     materials : a law, ``{subdomain: law}`` or a sequence of laws with ``regions`` (as for ``Solid``), or
-        a ready :class:`~skvalve.fem.constitutive.MaterialRegions`.
+        a ready :class:`~skvalve.fem.elements.constitutive.MaterialRegions`.
     regions : element -> material index, with a sequence of laws.
     fused : evaluate P and dP/dF at F_bar with the compiled laws of
-        :mod:`skvalve.fem.fused` (:func:`~skvalve.fem.fused.point_response_regions`) when every law has
-        one; otherwise, or with ``False``, through :meth:`~skvalve.fem.constitutive.MaterialRegions.evaluate`.
+        :mod:`skvalve.fem.elements.fused` (:func:`~skvalve.fem.elements.fused.point_response_regions`) when every law
+        has one; otherwise, or with ``False``, through
+        :meth:`~skvalve.fem.elements.constitutive.MaterialRegions.evaluate`.
     """
 
     name = "F-bar solid"

@@ -1,4 +1,4 @@
-"""Controls of pseudo-transient continuation (:func:`skvalve.fem.ptc.pseudo_transient`): one options class, its
+"""Controls of pseudo-transient continuation (:func:`skvalve.fem.solvers.ptc.pseudo_transient`): one options class, its
 every field documented and validated."""
 
 from __future__ import annotations
@@ -79,7 +79,7 @@ class PseudoTransientOptions:
         Give up (``ConvergenceError``, the best held state kept) when, with the load held at ``end``, the residual
         has not fallen below half its value of ``stall_steps`` steps before (0: never).
     solver : str or None
-        Sparse backend (:func:`skvalve.fem.linsolve.solver_name`).
+        Sparse backend (:func:`skvalve.fem.solvers.linsolve.solver_name`).
     """
 
     damping: float = 1e-4

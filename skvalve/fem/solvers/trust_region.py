@@ -1,9 +1,9 @@
 r"""Energy trust-region Newton at a held load: large steps along the soft, indefinite modes of a floppy structure.
 
-Pseudo-transient continuation (:mod:`skvalve.fem.ptc`) accepts a step when the residual does not blow up, so where a
-structure must travel through a region of negative curvature to reach its equilibrium (a valve still closing under
-its held pressure: leaflets that buckle towards coaptation) the residual rises and falls and the damping that keeps
-the linearised steps sane also keeps them short. This solver measures progress by the energy instead: for an
+Pseudo-transient continuation (:mod:`skvalve.fem.solvers.ptc`) accepts a step when the residual does not blow up, so
+where a structure must travel through a region of negative curvature to reach its equilibrium (a valve still closing
+under its held pressure: leaflets that buckle towards coaptation) the residual rises and falls and the damping that
+keeps the linearised steps sane also keeps them short. This solver measures progress by the energy instead: for an
 (almost) conservative problem the residual is the gradient of a potential :math:`\Pi`, and the change of
 :math:`\Pi` along a step :math:`p` is the work of the residual along it,
 
@@ -58,11 +58,11 @@ import numpy as np
 import scipy.sparse as sp
 from tqdm.auto import tqdm
 
+from ..errors import ConvergenceError, NonPositiveJacobianError, StateRefused
+from ..problem import Problem, Tangent
 from . import linsolve
-from .errors import ConvergenceError, NonPositiveJacobianError, StateRefused
 from .incremental import ENERGY_RESOLUTION
 from .newton import reference_force
-from .problem import Problem, Tangent
 from .ptc import _checked_edges, _limited, _stretch_changes, with_step_fraction
 from .trust_region_options import TrustRegionControl, TrustRegionOptions, TrustRegionResult, TrustRegionStep
 from .trust_steps import (
@@ -102,8 +102,9 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                  control: TrustRegionControl | None = None) -> TrustRegionResult:
     """Relax ``problem`` at the held load factor ``t`` from ``u0`` to an equilibrium (module docstring).
 
-    ``relax``: a :class:`~skvalve.fem.block_relaxation.BlockRelaxation` (``relax(u, t) -> (u, result)``, the result
-    with ``iterations`` and ``energy_change``) run before the first step and after each accepted one (e.g. the
+
+    ``relax``: a :class:`~skvalve.fem.solvers.block_relaxation.BlockRelaxation` (``relax(u, t) -> (u, result)``, the
+    result with ``iterations`` and ``energy_change``) run before the first step and after each accepted one (e.g. the
     chordae branch points brought to equilibrium with the rest held); its energy change is added to the step's.
 
     ``limit``: ``limit(u, p) -> f`` in (0, 1], the fraction of a step ``p`` (already held to the radius) that may be
@@ -113,10 +114,10 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
     ``control``: the :class:`TrustRegionControl` of an earlier run's accepted step (``event.control``), to go on from
     its state ``u0`` as that run would have (``max_steps`` counts the steps of both).
 
-    ``edges``/``rest_lengths`` as in :func:`~skvalve.fem.ptc.pseudo_transient`. Returns a :class:`TrustRegionResult`
-    with ``converged`` (or ``stalled``: :attr:`TrustRegionOptions.stall_fraction`) set; raises
-    :class:`~skvalve.fem.errors.ConvergenceError` (``error.last_state``: the result up to the last accepted step) when
-    the radius falls below ``min_radius``, the shift passes ``max_shift`` or ``max_steps`` pass.
+    ``edges``/``rest_lengths`` as in :func:`~skvalve.fem.solvers.ptc.pseudo_transient`. Returns a
+    :class:`TrustRegionResult` with ``converged`` (or ``stalled``: :attr:`TrustRegionOptions.stall_fraction`) set;
+    raises :class:`~skvalve.fem.errors.ConvergenceError` (``error.last_state``: the result up to the last accepted step)
+    when the radius falls below ``min_radius``, the shift passes ``max_shift`` or ``max_steps`` pass.
     """
     opts = options or TrustRegionOptions()
     if not math.isfinite(t):

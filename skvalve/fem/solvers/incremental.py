@@ -9,9 +9,10 @@ Each load step :math:`t_n \to t_{n+1}` minimises (Kane et al. 2000; Li et al. 20
     \tilde u = u_n + h\,v_n ,
 
 with :math:`\Pi = \sum_k \Pi_k` the terms' potentials (:meth:`~skvalve.fem.problem.Problem.energy`: strain energy,
-barrier contact, ...), :math:`M` a diagonal mass (``mass``: e.g. :func:`~skvalve.fem.damping.lumped_volume` times the
-input's density) and :math:`h` the time step; without a mass the step is the static problem, with ``velocity=False``
-:math:`\tilde u = u_n` (pseudo-mass: a proximal step that damps, whose fixed point is still the static equilibrium).
+barrier contact, ...), :math:`M` a diagonal mass (``mass``: e.g. :func:`~skvalve.fem.solvers.damping.lumped_volume`
+times the input's density) and :math:`h` the time step; without a mass the step is the static problem, with
+``velocity=False`` :math:`\tilde u = u_n` (pseudo-mass: a proximal step that damps, whose fixed point is still the
+static equilibrium).
 The stationarity of :math:`E` is implicit Euler. Each iteration solves :math:`A\,p = -\nabla E` for a descent
 direction :math:`p`, with :math:`A` chosen by ``direction``:
 
@@ -58,11 +59,11 @@ import numpy as np
 import scipy.sparse as sp
 from tqdm.auto import tqdm
 
+from ..errors import ConvergenceError, NonPositiveJacobianError
+from ..problem import Problem, Tangent
+from ..result import Result
 from . import linsolve
-from .errors import ConvergenceError, NonPositiveJacobianError
 from .newton import StepEvent, reference_force
-from .problem import Problem, Tangent
-from .result import Result
 from .trust_steps import project_psd
 
 __all__ = ["IncrementalOptions", "StepFailed", "incremental_potential", "minimise_step", "projected_tangent",

@@ -9,7 +9,7 @@ Residual and tangent (reference configuration :math:`\Omega_0`, :math:`P = \part
     K_{ai,bk} = \int_{\Omega_0} \frac{\partial N_a}{\partial X_J}\,\mathbb{A}_{iJkL}\,
                 \frac{\partial N_b}{\partial X_L}\,dV,\qquad \mathbb{A} = \partial P/\partial F,
 
-plus, for the mixed formulation, the pressure rows of :mod:`skvalve.fem.constitutive`. Element
+plus, for the mixed formulation, the pressure rows of :mod:`skvalve.fem.elements.constitutive`. Element
 forces and stiffness come from the compiled kernels of :mod:`skvalve.fem.kernels`.
 """
 
@@ -17,14 +17,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kinematics import determinant
+from ...kinematics import determinant
+from ..errors import NonPositiveJacobianError
+from ..kernels import element_forces, element_gradients, element_stiffness
+from ..loads import embed_3d
+from ..space import Space
+from ..terms import Blocks, Contribution, Term
 from .constitutive import MaterialRegions
-from .errors import NonPositiveJacobianError
 from .fused import assemble_regions
-from .kernels import element_forces, element_gradients, element_stiffness
-from .loads import embed_3d
-from .space import Space
-from .terms import Blocks, Contribution, Term
 
 __all__ = ["HyperelasticTerm"]
 
@@ -35,9 +35,9 @@ class HyperelasticTerm(Term):
     Parameters
     ----------
     space : the field's :class:`~skvalve.fem.space.Space`.
-    materials : the :class:`~skvalve.fem.constitutive.MaterialRegions` assigning laws to elements.
+    materials : the :class:`~skvalve.fem.elements.constitutive.MaterialRegions` assigning laws to elements.
     fused : evaluate stress, tangent and element matrices in one compiled pass
-        (:mod:`skvalve.fem.fused`) when every law supplies its invariant or principal derivatives;
+        (:mod:`skvalve.fem.elements.fused`) when every law supplies its invariant or principal derivatives;
         otherwise (and with ``False``) each law's ``pk1_and_tangent`` and the generic kernels.
     """
 
@@ -70,7 +70,7 @@ class HyperelasticTerm(Term):
             p_elem = u[sp_.element_dofs[:, nb * d:]]  # (nel, nbp)
             p = np.einsum("eqa,ea->qe", sp_.Np, p_elem)
         fused = assemble_regions(self.materials, F, sp_, tangent, p) if self.fused else None
-        if fused is not None:  # every law compiled with its element assembly (skvalve.fem.fused)
+        if fused is not None:  # every law compiled with its element assembly (skvalve.fem.elements.fused)
             P, fe, ke = fused.P, fused.forces, fused.stiffness
         else:
             P, fe, ke = self._generic(F, p, tangent)

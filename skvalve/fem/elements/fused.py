@@ -7,9 +7,9 @@ the element forces and stiffness of :mod:`skvalve.fem.kernels` (same layout, nod
 :math:`f_{ai} \mathrel{+}= w\,P_{iJ}N_{a,J}`, :math:`K_{ai,bk} \mathrel{+}= w\,N_{a,J}\mathbb{A}_{iJkL}N_{b,L}`.
 
 The point formulas (invariant laws and principal-value laws) are derived in
-:mod:`skvalve.fem.fused_points`.
+:mod:`skvalve.fem.elements.fused_points`.
 
-**Mixed u/p** (:mod:`skvalve.fem.constitutive`): with the pressure :math:`p` at the points,
+**Mixed u/p** (:mod:`skvalve.fem.elements.constitutive`): with the pressure :math:`p` at the points,
 :math:`P \mathrel{-}= p\operatorname{cof}F`, :math:`\mathbb{A} \mathrel{-}= pJ(H_{iJ}H_{kL} - H_{iL}H_{kJ})`,
 :math:`K_{up} = -\int N_{a,J}(\operatorname{cof}F)_{iJ}N^p_\beta`, and when :math:`\bar J` and the compliance
 :math:`1/U''(\bar J)` are given, :math:`f_p = \int N^p_\alpha(\bar J - J)` and
@@ -26,12 +26,12 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, prange
 
-from ..kinematics import determinant
-from ..materials.base import Hyperelastic
-from ..materials.derivatives import InvariantDerivatives, PrincipalDerivatives
+from ...kinematics import determinant
+from ...materials.base import Hyperelastic
+from ...materials.derivatives import InvariantDerivatives, PrincipalDerivatives
+from ..kernels import add_point_stiffness
 from .constitutive import MaterialRegions, invert_volumetric
 from .fused_points import invariant_point, inverse_transpose, principal_point
-from .kernels import add_point_stiffness
 
 __all__ = ["FusedLaw", "FusedResponse", "MixedFields", "fused_response", "assemble_regions",
            "point_response_regions"]
@@ -78,7 +78,7 @@ def _point_scratch(n_derivatives):
 def _law_point(kind, F, D, aux, has_direction, q, e, Fq, H, Dq, aq, Vq, S, Pq, A, tangent, G3, M3, B3, c3):
     """Point (q, e): Fq = F[:, :, q, e], H = Fq^{-T}, S, A = dP/dF (if ``tangent``), Pq = Fq S; returns det Fq.
 
-    The other 3x3 / 3-vector arguments are scratch arrays (see :mod:`skvalve.fem.fused_points`).
+    The other 3x3 / 3-vector arguments are scratch arrays (see :mod:`skvalve.fem.elements.fused_points`).
     """
     for i in range(3):
         for j in range(3):
@@ -259,7 +259,7 @@ class FusedLaw:
     def point_response(self, F: np.ndarray, tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """``P`` (3,3,nqp,nel) and ``A[e, q, i, J, k, L]`` :math:`= \\partial P_{iJ}/\\partial F_{kL}` (None unless
         ``tangent``) at every point of ``F`` (3,3,nqp,nel): the layout of
-        :meth:`~skvalve.fem.constitutive.MaterialRegions.evaluate`, one compiled loop."""
+        :meth:`~skvalve.fem.elements.constitutive.MaterialRegions.evaluate`, one compiled loop."""
         nqp, nel = F.shape[2:] if np.ndim(F) == 4 else (0, 0)
         P = np.empty((3, 3, nqp, nel))
         A = np.empty((nel, nqp, 3, 3, 3, 3)) if tangent else None

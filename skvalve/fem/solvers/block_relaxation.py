@@ -6,8 +6,8 @@ sees a hub's slack side overshoots it, and a hub that a global step leaves out o
 residual (on the 1.0 diseased valve at the held load, 2 hubs held half of :math:`\lVert R\rVert^2`). Their own
 equilibrium, with every other dof held, is a small problem: Newton on the hubs' dofs with the residual and tangent of
 the terms that touch them (:class:`BlockRelaxation`), each iteration's step kept when the energy those terms store
-falls along it (the work of their residual, :func:`~skvalve.fem.trust_region.work_along`'s Simpson rule), halved
-otherwise. Running it after each accepted step of :func:`~skvalve.fem.trust_region.trust_region` is a nonlinear
+falls along it (the work of their residual, :func:`~skvalve.fem.solvers.trust_region.work_along`'s Simpson rule), halved
+otherwise. Running it after each accepted step of :func:`~skvalve.fem.solvers.trust_region.trust_region` is a nonlinear
 Gauss–Seidel sweep over the block (nonlinear elimination: Cai & Keyes 2002): it lowers the energy, and the
 equilibrium of the whole problem is unchanged.
 """
@@ -21,7 +21,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .problem import Problem
+from ..problem import Problem
 from .trust_region import work_along
 
 __all__ = ["BlockRelaxation", "BlockRelaxationResult"]

@@ -28,9 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..materials.uniaxial import TensionOnly, UniaxialLaw
-from .space import Space
-from .terms import Blocks, Contribution, Term
+from ...materials.uniaxial import TensionOnly, UniaxialLaw
+from ..space import Space
+from ..terms import Blocks, Contribution, Term
 
 __all__ = ["BarResponse", "bar_response", "BarEnd", "LawAssignment", "Truss"]
 

@@ -1,6 +1,6 @@
 r"""Stress and tangent at one quadrature point from the scalar derivatives a law supplies (numba).
 
-Used by the element kernel of :mod:`skvalve.fem.fused`; every function works on one point and
+Used by the element kernel of :mod:`skvalve.fem.elements.fused`; every function works on one point and
 writes into caller-provided scratch arrays.
 
 **Invariant laws** :math:`\psi(\bar I_1, J, I_4)`. With :math:`G = C^{-1}`, :math:`H = FG = F^{-T}`,

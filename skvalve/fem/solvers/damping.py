@@ -22,9 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .problem import Problem
-from .space import Space
-from .terms import Blocks, Contribution, Term
+from ..problem import Problem
+from ..space import Space
+from ..terms import Blocks, Contribution, Term
 
 __all__ = ["DampingSchedule", "ViscousDamping", "undamped_residual", "lumped_volume"]
 
