@@ -82,14 +82,14 @@ def test_a_supported_deck_builds_and_reports_nothing(tmp_path):
 @pytest.mark.skipif("1.0-clipping" not in trivalve_inputs(), reason="Texas TriValve 1.0 clipping input not found")
 def test_the_shipped_clip_repair_is_accepted_with_its_bonded_contact_noted():
     """Four rigid arms, two inert Slot connectors, two further steps and four arm rotations (65 and 35 degrees) are
-    modelled; the bonded Rough_Interaction (line 75482, found with grep) is noted as the frictionless barrier, and so
-    are the arms' contact starting in step 2 (the first Contact Pair with an arm, line 76531)."""
+    modelled; the bonded Rough_Interaction (line 75482, found with grep) is noted as the barrier with a tie after
+    capture, and so are the arms' contact starting in step 2 (the first Contact Pair with an arm, line 76531)."""
     logging.getLogger("skvalve.io.abaqus.reader").setLevel(logging.ERROR)
     abaqus = read_model(trivalve_inputs()["1.0-clipping"])
     assert unsupported_features(abaqus) == []
     notes = check_supported(abaqus)
     assert [note.split(": ")[0].rsplit(":", 1)[1] for note in notes] == ["75482", "76531"]
-    assert "*Friction, rough and *Surface Behavior, no separation" in notes[0] and "no tie after capture" in notes[0]
+    assert "*Friction, rough and *Surface Behavior, no separation" in notes[0] and "tie after capture" in notes[0]
     # step 1 alone (the earlier partial build) still builds: the arms are parked there
     model = valve_model(abaqus, partial=True)
     assert model.end_time == 1.0 and len(model.obstacles) == 4

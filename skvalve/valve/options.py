@@ -75,6 +75,12 @@ class ContactOptions:
         (``ModelOptions.corner_threshold``).
     friction
         ``None`` (frictionless; the 1.0 inputs' friction 0.001 is negligible) or a :class:`Friction`.
+    tie_within
+        the clip arms' rough, no-separation contact (the input's ``*Friction, rough`` with ``*Surface Behavior, no
+        separation``): a leaflet vertex within this distance (mm) of an active arm at an accepted step is tied to its
+        point on the arm from then on (:class:`~skvalve.fem.contact.tie.ObstacleTie`; stiffness
+        :data:`~skvalve.valve.setup.TIE_FACTOR` times the peak pressure over ``dhat``). 0.1 mm: within the barrier's
+        range, i.e. touching. 0: frictionless arms.
     check_intersections
         assert after every accepted step that the collision mesh does not intersect
         (``has_intersections``, ~0.03 s on the 1.0 valve): a guard, since the collision-free line search makes it
@@ -85,12 +91,14 @@ class ContactOptions:
     pressure_factor: float = 2.0
     exclude_within: float = 1.0
     friction: Friction | None = None
+    tie_within: float = 0.1
     check_intersections: bool = True
 
     def __post_init__(self) -> None:
         _positive("ContactOptions", "dhat", self.dhat)
         _positive("ContactOptions", "pressure_factor", self.pressure_factor)
         _positive("ContactOptions", "exclude_within", self.exclude_within, zero=True)
+        _positive("ContactOptions", "tie_within", self.tie_within, zero=True)
 
 
 @dataclass(frozen=True)

@@ -1,5 +1,6 @@
-"""The valve closure's model: the input's implicit model, a barrier against folding hex corners
-(:class:`~skvalve.fem.elements.corner_barrier.CornerBarrier`) and IPC contact on the leaflets' hex boundary.
+"""The valve closure's model: the input's implicit model, IPC contact on the leaflets' hex boundary, a barrier against
+folding hex corners (:class:`~skvalve.fem.elements.corner_barrier.CornerBarrier`) and, with clip arms, the tie that
+keeps what they capture (:class:`~skvalve.fem.contact.tie.ObstacleTie`).
 
 :func:`valve_setup` builds what :func:`skvalve.valve.run.close_valve` solves and what the outputs
 (:mod:`.outputs`, the mathur2022 figures) measure: the :class:`~skvalve.valve.model.ValveModel`, its
@@ -16,6 +17,7 @@ import numpy as np
 
 from ..fem.contact import IPCContact
 from ..fem.contact.ipc import stiffness_for_pressure
+from ..fem.contact.tie import ObstacleTie
 from ..fem.elements.corner_barrier import CornerBarrier
 from ..fem.loads import FollowerPressure
 from ..fem.problem import Problem
@@ -25,7 +27,11 @@ from .extrude import hex_corner_jacobians
 from .model import ABAQUS_TO_SKFEM_HEX, ValveModel, valve_model
 from .options import CloseOptions
 
-__all__ = ["ValveSetup", "end_load_norm", "pressure_forces", "smallest_corner_jacobian", "valve_setup"]
+#: the clip arms' tie holds a captured vertex with k = TIE_FACTOR x (peak pressure) / dhat per unit area: under the
+#: peak pressure over its own area a tied vertex sits dhat / 1000 (0.1 um) off its point on the arm
+TIE_FACTOR = 1000.0
+
+__all__ = ["TIE_FACTOR", "ValveSetup", "end_load_norm", "pressure_forces", "smallest_corner_jacobian", "valve_setup"]
 
 
 @dataclass
@@ -53,14 +59,18 @@ def valve_setup(source: str | Path | AbaqusModel, options: CloseOptions | None =
     peak = max((abs(load.magnitude) for load in model.pressures), default=0.0)
     if peak <= 0.0:
         raise ValueError(f"{abaqus.path}: no pressure load; the closure needs the transvalvular pressure")
-    if options.model.corner_threshold > 0.0:
-        moduli = np.array([law.shear_modulus for law in model.laws])[model.regions]
-        problem.add_term(CornerBarrier(problem.space, moduli, options.model.corner_threshold))
     c = options.contact
     stiffness = stiffness_for_pressure(c.pressure_factor * peak, c.dhat, 0.5)
     contact = problem.add_term(IPCContact(problem.space, dhat=c.dhat, stiffness=stiffness,
                                           obstacles=model.obstacles, exclude_within=c.exclude_within,
                                           friction=c.friction, check_intersections=c.check_intersections))
+    # terms added after the contact, so that the kept states of runs without them keep their terms' numbers
+    if options.model.corner_threshold > 0.0:
+        moduli = np.array([law.shear_modulus for law in model.laws])[model.regions]
+        problem.add_term(CornerBarrier(problem.space, moduli, options.model.corner_threshold))
+    if model.obstacles and c.tie_within > 0.0:
+        problem.add_term(ObstacleTie(problem.space, contact.nodes, contact.area[contact.nodes], model.obstacles,
+                                     capture=c.tie_within, stiffness=TIE_FACTOR * peak / c.dhat))
     leaflet = np.full(model.mesh.p.shape[1], -1, dtype=np.int64)
     leaflet[model.mesh.t] = model.regions[None, :]
     volumes = lumped_volume(problem.space)

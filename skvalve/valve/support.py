@@ -17,15 +17,17 @@ Modelled
 * **Inert connectors**: ``CONN3D2`` of translational types (``Slot``, ...) between nodes held in dofs 1-3 cannot act
   and are dropped.
 * **Contact with the arms** (``*Contact Pair`` / ``*Contact Inclusions`` with an arm surface): the arms' whole facet
-  surface is an obstacle of the frictionless IPC barrier, from the total time the arm starts to turn
+  surface is an obstacle of the IPC barrier, from the total time the arm starts to turn
   (:class:`~skvalve.fem.contact.obstacles.Obstacle` ``active_from``).
 
 Approximated (a note on the model)
 ----------------------------------
 * ``*Friction, rough`` and ``*Surface Behavior, no separation`` between the arms and the leaflets (the clip's
-  ``Rough_Interaction``: once touching, bonded): frictionless barrier contact, so a captured leaflet may slide
-  and separate. The tie after capture is a separate piece (a history-dependent bond: a node that touches a
-  ``Contact_Surf`` facet held by a penalty spring to that material point of the arm, committed per step).
+  ``Rough_Interaction``: once touching, bonded): the IPC barrier plus a tie after capture
+  (:class:`~skvalve.fem.contact.tie.ObstacleTie`): a leaflet vertex within ``ContactOptions.tie_within`` of an arm
+  at an accepted step is held by a stiff spring to that material point of the arm from then on. Captures are decided
+  per accepted step, not at the instant of first touch, and the bond is elastic (stiffness
+  :data:`~skvalve.valve.setup.TIE_FACTOR` times the peak pressure over ``dhat``), not rigid.
 * Contact with an arm starts when it starts to turn (the start of *Clip close*), not with the step that defines it
   (*Clip capture*): the leaflets closed in the step before overlap the parked arms, which the barrier cannot start
   from; the capture step's released pressure reopens the valve first.
@@ -55,7 +57,7 @@ Four rigid clip arms (parts ``Clip-1-1``, ``Clip-1-2``, ``Clip-2-1``, ``Clip-2-2
    (0-0.5), then the pressure returns (``Amp-1``, 0.5-1.0).
 
 The two ``Slot`` connectors join the reference nodes of each clip's two arms, all of whose translations are held:
-inert. All of this is modelled except the bonded (rough, no-separation) contact, which is approximated as above.
+inert. All of this is modelled; the bonded (rough, no-separation) contact is approximated as above.
 Re-opening in step 2 under zero pressure is an unloading path for the quasi-static solver; the damping used for
 closing helps, but the open state is then only approximately the step-1 reference.
 """
@@ -247,7 +249,7 @@ def _changing_dofs(histories: dict[tuple[int, int], History], modelled: np.ndarr
 
 def approximation_notes(abaqus: AbaqusModel, step: int | None = None) -> list[str]:
     """What the model represents only approximately (module docstring): bonded contact with the clip arms as the
-    frictionless barrier, and arm contact that starts when the arm starts to turn, not with its step."""
+    barrier with a tie after capture, and arm contact that starts when the arm starts to turn, not with its step."""
     parts = _rigid_parts(abaqus, _histories(abaqus, step))
     if not parts.arm_elements:
         return []
@@ -261,7 +263,9 @@ def approximation_notes(abaqus: AbaqusModel, step: int | None = None) -> list[st
             interaction = abaqus.interactions.get(name)
             if interaction is not None and (interaction.rough or interaction.no_separation):
                 note = (f"{interaction.location}: {interaction.name} ({_bond(interaction)}) between the clip arms and "
-                        "the leaflets is modelled as the frictionless IPC barrier: no tie after capture")
+                        "the leaflets is modelled as the IPC barrier with a tie after capture: a leaflet vertex that "
+                        "touches an arm at an accepted step is held to its point on the arm by a stiff spring "
+                        "(ContactOptions.tie_within)")
                 if note not in notes:
                     notes.append(note)
     if first is not None and first[0] > 0:

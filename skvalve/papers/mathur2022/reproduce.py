@@ -18,7 +18,7 @@ in ``out/<key>`` (``1.0-diseased``, ``1.1-healthy``, ...: the 1.0 and 1.1 diseas
 from the state kept there, so an interrupted ``--full`` goes on where it stopped; each input's run summary (wall
 time, steps, iterations, residual, intersection, smallest Jacobian), figures and rows follow it. The clip input runs
 its three steps in total time (0-2.5) with its four rigid arms as moving IPC obstacles (:mod:`skvalve.valve.clip`);
-its rough, no-separation arm contact is the frictionless barrier there (the model's notes say so). An input the
+its rough, no-separation arm contact is the barrier with a tie after capture (the model's notes say so). An input the
 model cannot represent is reported as not computed, with the keywords it refuses.
 
 The model files (Mathur et al. 2022, CC BY-NC-SA 4.0; Texas TriValve 1.1, CC BY 4.0) are never copied; without them
