@@ -39,7 +39,7 @@ def _tied_cube(active_from: float = 0.0, capture: float = 0.1):
 def test_captured_vertices_follow_the_obstacles_rigid_motion():
     """A cube held only by its bottom face's capture moves with the plate: u = R(X - c) + c + a - X exactly."""
     mesh, solid, tie = _tied_cube()
-    tie.assemble(np.zeros(solid.space.n_dofs), 0.0, False, None)
+    tie.assemble(np.zeros(solid.space.n_dofs), 0.0, True, None)
     tie.commit()
     bottom = np.flatnonzero(mesh.p[2] == 0.0)
     assert sorted(tie.captured.tolist()) == sorted(bottom.tolist())  # the top face is 1.05 away
@@ -52,11 +52,11 @@ def test_captured_vertices_follow_the_obstacles_rigid_motion():
 def test_nothing_is_captured_before_the_obstacle_is_active_or_out_of_reach():
     _, solid, tie = _tied_cube(active_from=0.5)
     u = np.zeros(solid.space.n_dofs)
-    tie.assemble(u, 0.2, False, None)
+    tie.assemble(u, 0.2, True, None)
     tie.commit()
     assert tie.captured.size == 0
     _, solid, tie = _tied_cube(capture=0.04)
-    tie.assemble(u, 0.0, False, None)
+    tie.assemble(u, 0.0, True, None)
     tie.commit()
     assert tie.captured.size == 0
 
@@ -64,7 +64,7 @@ def test_nothing_is_captured_before_the_obstacle_is_active_or_out_of_reach():
 def test_forces_are_the_energy_gradient_and_the_tangent_its_hessian():
     _, solid, tie = _tied_cube()
     n = solid.space.n_dofs
-    tie.assemble(np.zeros(n), 0.0, False, None)
+    tie.assemble(np.zeros(n), 0.0, True, None)
     tie.commit()
     u = 0.05 * np.random.default_rng(1).standard_normal(n)
     contribution = tie.assemble(u, 0.4, True, None)
@@ -80,7 +80,7 @@ def test_forces_are_the_energy_gradient_and_the_tangent_its_hessian():
 def test_captures_survive_a_state_round_trip():
     _, solid, tie = _tied_cube()
     n = solid.space.n_dofs
-    tie.assemble(np.zeros(n), 0.0, False, None)
+    tie.assemble(np.zeros(n), 0.0, True, None)
     tie.commit()
     u = 0.05 * np.random.default_rng(2).standard_normal(n)
     _, _, fresh = _tied_cube()

@@ -228,7 +228,7 @@ def test_the_arms_join_the_contact_when_they_start_to_turn(clip):
     (tie,) = [term for term in setup.problem.terms if isinstance(term, ObstacleTie)]
     assert tie.obstacles == model.obstacles and np.array_equal(tie.nodes, setup.contact.nodes)
     for t in (1.49, 1.5):
-        tie.assemble(u, t, False, None)
+        tie.assemble(u, t, True, None)
         tie.commit()
         assert tie.captured.size == 0
 

@@ -26,8 +26,9 @@ rigid obstacle the frame moves rigidly, so a captured vertex follows the obstacl
 The force is :math:`kA_v(x_v - z_v)`, the tangent the constant diagonal :math:`kA_v I`; :math:`z_v` depends on the load
 factor only (obstacles have no unknowns), so the term is load dependent and conservative at a fixed load factor.
 
-Captures are decided in :meth:`ObstacleTie.commit` at the last evaluated state (as IPC's friction lag is), so within a
-step the problem does not change; :meth:`ObstacleTie.state` keeps them for a resumed run.
+Captures are decided in :meth:`ObstacleTie.commit` at the state of the last assembly with a tangent (the solvers
+assemble the tangent at the state they accept, line-search and quadrature trials without), so within a step the
+problem does not change; :meth:`ObstacleTie.state` keeps them for a resumed run.
 """
 
 from __future__ import annotations
@@ -126,14 +127,14 @@ class ObstacleTie(Term):
 
     # --------------------------------------------------------------------- term
     def energy(self, u: np.ndarray, t: float) -> float:
-        self._last = (np.array(u, copy=True), float(t))
         if self.vertex.size == 0:
             return 0.0
         gap = self._positions(u, self.vertex) - self.targets(t)
         return float(0.5 * self.stiffness * np.sum(self.areas[self.vertex] * np.sum(gap * gap, axis=1)))
 
     def assemble(self, u: np.ndarray, t: float, tangent: bool, step: int | None) -> Contribution:
-        self._last = (np.array(u, copy=True), float(t))
+        if tangent:  # the solvers assemble the tangent at the state they accept, not at line-search trials
+            self._last = (np.array(u, copy=True), float(t))
         n = self.space.n_dofs
         internal = np.zeros(n)
         if self.vertex.size:
@@ -146,7 +147,8 @@ class ObstacleTie(Term):
 
     # -------------------------------------------------------------------- state
     def commit(self) -> None:
-        """Capture the free vertices within ``capture`` of an active obstacle at the last evaluated state."""
+        """Capture the free vertices within ``capture`` of an active obstacle at the state of the last assembly with
+        a tangent."""
         if self._last is None:
             return
         u, t = self._last
