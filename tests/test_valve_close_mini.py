@@ -19,6 +19,7 @@ import pytest
 from _mini_valve import write_mini_valve
 
 from skvalve.cli import main
+from skvalve.fem.contact.ipc import IntersectionError, IPCContact
 from skvalve.valve.options import CloseOptions
 from skvalve.valve.run import close_valve, relative_residual
 from skvalve.valve.setup import pressure_forces, valve_setup
@@ -117,3 +118,25 @@ def test_the_deck_is_read_as_the_shipped_inputs_are(closed):
     assert model.mesh.t.shape[1] == 24 and len(model.pressures) == 1
     assert model.chordae.ends.shape == (6, 2)  # two-bar chains collapsed into one cable each
     assert Path(deck).read_text().startswith("** skvalve test deck")
+
+
+def test_a_path_state_the_contact_refuses_is_a_cut_back(closed, monkeypatch):
+    """A converged path step whose state a term refuses (an intersection among excluded primitives, here faked once
+    at the first state past step time 0.5) is cut back like a failed step and the run goes on to the same kind of end;
+    the refused state is never accepted."""
+    deck, _, _ = closed
+    refused: list[float] = []
+    original = IPCContact.check_state
+
+    def refuse_once(self, u, t):
+        if t > 0.5 and not refused:
+            refused.append(t)
+            raise IntersectionError(f"faked at load factor {t}")
+        return original(self, u, t)
+
+    plain = close_valve(deck, progress=False)
+    monkeypatch.setattr(IPCContact, "check_state", refuse_once)
+    report = close_valve(deck, progress=False)
+    assert len(refused) == 1 and report.converged and report.relative_residual <= 1e-6
+    assert report.failed_steps == plain.failed_steps + 1
+    assert refused[0] not in [record.t for record in report.records if record.phase == "path"]

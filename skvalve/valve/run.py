@@ -35,7 +35,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ..fem.elements.truss import Truss
-from ..fem.errors import ConvergenceError, NonPositiveJacobianError, SingularSystemError, SolverError
+from ..fem.errors import ConvergenceError, NonPositiveJacobianError, SingularSystemError, SolverError, StateRefused
 from ..fem.solvers import linsolve
 from ..fem.solvers.block_relaxation import BlockRelaxation
 from ..fem.solvers.incremental import IncrementalOptions, StepFailed, minimise_step
@@ -176,10 +176,14 @@ class _Run:
         return u, residual, history
 
     def attempt(self, t_new: float, inertia_scale: float, rtol: float, max_iter: int) -> _Outcome | None:
-        """:meth:`step`, or ``None`` after rewinding the terms when it fails."""
+        """:meth:`step`, or ``None`` after rewinding the terms when it fails. A converged step whose state a term
+        refuses (:class:`~skvalve.fem.errors.StateRefused`: an intersection among collision primitives that the
+        barrier excludes) fails too, so the step is cut back instead of ending the run."""
         try:
-            return _Outcome(*self.step(t_new, inertia_scale, rtol, max_iter))
-        except (StepFailed, NonPositiveJacobianError, SingularSystemError, np.linalg.LinAlgError) as err:
+            outcome = _Outcome(*self.step(t_new, inertia_scale, rtol, max_iter))
+            self.problem.check_state(outcome.u, t_new)
+            return outcome
+        except (StepFailed, NonPositiveJacobianError, SingularSystemError, StateRefused, np.linalg.LinAlgError) as err:
             self.problem.rewind()
             self.failed += 1
             logger.info("step to t=%.6g failed: %s", t_new, err)
@@ -189,8 +193,7 @@ class _Run:
     def accept(self, u: np.ndarray, t: float, residual: np.ndarray, history: list) -> float:
         """Commit an accepted step and return its static relative residual."""
         problem = self.problem
-        problem.commit()
-        problem.check_state(u, t)
+        problem.commit()  # its state was vetted in attempt()
         relative = relative_residual(self.setup, residual)
         s = self.state
         s.u, s.t, s.relative_residual = u, float(t), relative
