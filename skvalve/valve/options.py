@@ -49,9 +49,6 @@ class ModelOptions:
         _positive("ModelOptions", "corner_threshold", self.corner_threshold, zero=True)
         if not self.corner_threshold < 1.0:
             raise ValueError(f"ModelOptions.corner_threshold must lie in [0, 1); got {self.corner_threshold!r}")
-        _positive("ModelOptions", "corner_threshold", self.corner_threshold, zero=True)
-        if not self.corner_threshold < 1.0:
-            raise ValueError(f"ModelOptions.corner_threshold must lie in [0, 1); got {self.corner_threshold!r}")
 
 
 @dataclass(frozen=True)

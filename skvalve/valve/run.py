@@ -13,9 +13,8 @@ grows after easy steps and halves after failed ones. The line search's merit is 
 follower pressure's work along the ray, by the trapezoidal rule (the pressure on the leaflets' open surface has no
 potential). Held load (:class:`~skvalve.valve.options.HoldOptions`, :func:`held_stages`): the energy trust region
 (:func:`~skvalve.fem.solvers.trust_region.trust_region`) at the end time, a *descend* stage of projected steps of up to
-a
-millimetre until their energy drop stalls, then a *settle* stage on the symmetric tangent with Newton's steps at
-the end, to ``rtol`` (1e-6) of the undamped problem; the chordae branch points are relaxed after every step.
+a millimetre until their energy drop stalls, then a *settle* stage on the symmetric tangent with Newton's steps at the
+end, to ``rtol`` (1e-6) of the undamped problem; the chordae branch points are relaxed after every step.
 
 Output in ``out``: ``state.npz`` after every accepted step (atomic, :mod:`skvalve.valve.state`; ``resume=True``
 continues from it and repeats the uninterrupted run), ``closure.log`` (one line per step), and at the end
