@@ -13,8 +13,8 @@ from skvalve.valve.state import FORMAT, KeptState, StateError, read_state, write
 
 
 def _options() -> CloseOptions:
-    return CloseOptions(ModelOptions(insertion="node", cable_compression=False),
-                        ContactOptions(dhat=0.05, friction=Friction(0.2, 1e-3)),
+    return CloseOptions(ModelOptions(insertion="node", cable_compression=False, corner_threshold=0.2),
+                        ContactOptions(dhat=0.05, friction=Friction(0.2, 1e-3), tie_within=0.03),
                         StepOptions(first=0.02, largest=0.1), HoldOptions(rtol=1e-7), end=0.5, solver="scipy")
 
 
@@ -32,6 +32,9 @@ def test_options_round_trip_through_json():
     (lambda: StepOptions(growth=0.5), "growth"),
     (lambda: HoldOptions(max_steps=-1), "max_steps"),
     (lambda: ModelOptions(insertion="glue"), "insertion"),
+    (lambda: ModelOptions(corner_threshold=1.0), "corner_threshold"),
+    (lambda: ModelOptions(corner_threshold=-0.1), "corner_threshold"),
+    (lambda: ContactOptions(tie_within=-1.0), "tie_within"),
     (lambda: CloseOptions(end=-1.0), "end"),
 ])
 def test_bad_option_names_its_field(make, name):
