@@ -62,14 +62,16 @@ class ContactOptions:
         the stiffness κ carries this many times the input's largest pressure at half of ``dhat``
         (:func:`~skvalve.fem.contact.ipc.stiffness_for_pressure`): coapting leaflets then meet about ``dhat``/2 apart.
     exclude_within
-        body vertices closer than this (mm) in the reference never collide: a leaflet's own skins and neighbours
-        where it folds sharply, at the chordae insertions and the commissures. An excluded pair is one the barrier and
-        the collision-free step do not see, so it can cross: on the 1.0 diseased valve's held load a settle step
-        crossed two edges of one free-edge hex (0.53 mm apart in the reference; the hex's smallest corner Jacobian
-        -5.4e-5: a folded corner). Without any exclusion the barrier held that corner and the settle stage went on, but
-        the posterior leaflet's papillary stage jammed (relative residual 1e7 at its sixth step, steps capped to 1e-3
-        of their length): the barrier is no guard against a folding element; the element resists it itself
-        (``ModelOptions.corner_threshold``).
+        body vertices closer than this (mm) in the reference never collide. 0 (every pair collides): an excluded pair
+        is one the barrier and the collision-free step do not see, so the minimiser can drive it through itself. With
+        1 mm (the default before this version): on the 1.0 diseased valve's held load two edges of one free-edge hex
+        crossed (a folded corner); the 1.1 healthy input's path reached an intersecting state at step time 0.933,
+        and from 0.919 every step was refused, down to 1.4e-6 of step time. Without exclusion, the posterior leaflet's
+        papillary stage once jammed between a folding hex's own faces (relative residual 1e7, steps capped to 1e-3
+        of their length); with the corner barrier (``ModelOptions.corner_threshold``) the same leaflet now closes
+        without exclusion (27 + 67 steps, 526 iterations, 2.2e-11), and the whole 1.0 diseased valve's held load
+        converged without it (6.2e-10). At rest the 1.1 healthy and diseased inputs then have 2 and 1 pairs within
+        ``dhat`` (0.093 and 0.096 mm apart); the 1.0 inputs have none.
     friction
         ``None`` (frictionless; the 1.0 inputs' friction 0.001 is negligible) or a :class:`Friction`.
     tie_within
@@ -86,7 +88,7 @@ class ContactOptions:
 
     dhat: float = 0.1
     pressure_factor: float = 2.0
-    exclude_within: float = 1.0
+    exclude_within: float = 0.0
     friction: Friction | None = None
     tie_within: float = 0.1
     check_intersections: bool = True
