@@ -32,7 +32,7 @@
 # | chordae law (3-term Ogden, uniaxial) | Eq. 2 | `skvalve.materials.uniaxial.OgdenUniaxial` |
 # | parameters as shipped in the input | Tables S1–S2 (supplement) | `skvalve.papers.mathur2022.data` |
 # | the valve: hexes, cables, conditions, pressure | Sects. 2.5–2.9 | `skvalve.valve.model.valve_model` |
-# | implicit quasi-static closure | Sect. 2.8 (explicit there) | `fem.solvers.newton.solve` (§3), `valve.run.close_valve` (§4) |
+# | implicit quasi-static closure | Sect. 2.8 (explicit) | `fem.solvers.newton.solve` §3, `valve.run.close_valve` §4 |
 # | Tables 2–3 | Sect. 3.3 | `skvalve.valve.outputs`, `skvalve.papers.mathur2022.data` |
 #
 # Every number the text quotes is computed in a cell and checked there against a closed form or the paper. Units are
