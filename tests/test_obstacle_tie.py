@@ -61,11 +61,17 @@ def test_nothing_is_captured_before_the_obstacle_is_active_or_out_of_reach():
     assert tie.captured.size == 0
 
 
-def test_forces_are_the_energy_gradient_and_the_tangent_its_hessian():
+def _captured_cube():
+    """The tied cube with its bottom face captured at the reference state (``n``: its dofs)."""
     _, solid, tie = _tied_cube()
     n = solid.space.n_dofs
     tie.assemble(np.zeros(n), 0.0, True, None)
     tie.commit()
+    return tie, n
+
+
+def test_forces_are_the_energy_gradient_and_the_tangent_its_hessian():
+    tie, n = _captured_cube()
     u = 0.05 * np.random.default_rng(1).standard_normal(n)
     contribution = tie.assemble(u, 0.4, True, None)
     h = 1e-6
@@ -78,10 +84,7 @@ def test_forces_are_the_energy_gradient_and_the_tangent_its_hessian():
 
 
 def test_captures_survive_a_state_round_trip():
-    _, solid, tie = _tied_cube()
-    n = solid.space.n_dofs
-    tie.assemble(np.zeros(n), 0.0, True, None)
-    tie.commit()
+    tie, n = _captured_cube()
     u = 0.05 * np.random.default_rng(2).standard_normal(n)
     _, _, fresh = _tied_cube()
     fresh.restore({key: np.array(value) for key, value in tie.state().items()})

@@ -119,8 +119,9 @@ class ObstacleTie(Term):
         for k, obstacle in enumerate(self.obstacles):
             mine = np.flatnonzero(self.obstacle == k)
             if mine.size:
-                e1, e2, n = _frames(obstacle.at(t)[obstacle.triangles[self.triangle[mine]]])
-                y0 = obstacle.at(t)[obstacle.triangles[self.triangle[mine], 0]]
+                y = obstacle.at(t)[obstacle.triangles[self.triangle[mine]]]  # (k, 3, 3)
+                e1, e2, n = _frames(y)
+                y0 = y[:, 0]
                 a, b, c = self.coords[mine].T
                 z[mine] = y0 + a[:, None] * e1 + b[:, None] * e2 + c[:, None] * n
         return z

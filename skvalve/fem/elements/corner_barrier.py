@@ -161,8 +161,9 @@ class CornerBarrier(Term):
         """:math:`r_c = J_c(x)/J_c(X)` of every guarded corner at ``u`` (8 per element, in element order)."""
         return self._determinants(self.positions(u)) / self.reference
 
-    def _checked_ratios(self, u: np.ndarray, t: float, step: int | None) -> np.ndarray:
-        r = self.ratios(u)
+    def _checked_ratios(self, edges: np.ndarray, t: float, step: int | None) -> np.ndarray:
+        """The ratios from the corners' ``edges`` (:meth:`_edges`); a folded corner raises, naming its element."""
+        r = _triple(edges[:, 0], edges[:, 1], edges[:, 2]) / self.reference
         bad = ~(np.isfinite(r) & (r > 0.0))
         if np.any(bad):
             raise NonPositiveJacobianError(np.unique(self.owner[bad]), step, t, term=f"{self.name} (a folded corner)")
@@ -170,19 +171,20 @@ class CornerBarrier(Term):
 
     # ------------------------------------------------------------------ terms
     def energy(self, u: np.ndarray, t: float) -> float:
-        s = self._checked_ratios(u, t, None) / self.threshold
+        s = self._checked_ratios(self._edges(self.positions(u)), t, None) / self.threshold
         active = s < 1.0
         return float(np.sum(self.weight[active] * corner_barrier_phi(s[active])[0]))
 
     def assemble(self, u: np.ndarray, t: float, tangent: bool, step: int | None) -> Contribution:
         n = self.space.n_dofs
-        s = self._checked_ratios(u, t, step) / self.threshold
+        edges = self._edges(self.positions(u))
+        s = self._checked_ratios(edges, t, step) / self.threshold
         active = np.flatnonzero(s < 1.0)
         internal = np.zeros(n)
         if active.size == 0:
             empty = sp.csr_matrix((n, n)) if tangent else None
             return Contribution(internal=internal, matrix=empty, projected_matrix=empty)
-        e = self._edges(self.positions(u))[active]  # (a, 3, 3): e[:, i] = e_i
+        e = edges[active]  # (a, 3, 3): e[:, i] = e_i
         grad_e = np.stack([np.cross(e[:, 1], e[:, 2]), np.cross(e[:, 2], e[:, 0]), np.cross(e[:, 0], e[:, 1])], 1)
         grad = grad_e.reshape(-1, 9) @ _EDGES  # (a, 12) = dJ/dx
         _, d1, d2 = corner_barrier_phi(s[active])
@@ -214,7 +216,8 @@ class CornerBarrier(Term):
     def step_fraction(self, u0: np.ndarray, t0: float, u1: np.ndarray, t1: float) -> float:
         """0.9 of the share of the straight move from ``u0`` to ``u1`` before any corner's Jacobian reaches zero (1 when
         none does)."""
-        e, d = self._edges(self.positions(u0)), self._edges(self.positions(u1)) - self._edges(self.positions(u0))
+        e = self._edges(self.positions(u0))
+        d = self._edges(self.positions(u1)) - e
         e1, e2, e3, d1, d2, d3 = e[:, 0], e[:, 1], e[:, 2], d[:, 0], d[:, 1], d[:, 2]
         c0 = _triple(e1, e2, e3)
         c1 = _triple(d1, e2, e3) + _triple(e1, d2, e3) + _triple(e1, e2, d3)
