@@ -178,6 +178,35 @@ def test_the_search_memory_saved_with_a_state_gives_back_its_active_set():
         contact.restore({"previous_triangle": np.zeros(3, dtype=int)})
 
 
+def test_problem_state_is_keyed_by_term_name():
+    """``Problem.state`` keys a term's arrays by its name, so a term added before it does not move its keys; a second
+    term of the same name is ``name#2``; positional keys (kept states of format 3) still restore; a key that names no
+    term is refused, naming it."""
+    problem, contact = block_contact_problem(2, 3, 30.0)
+    u = np.zeros(problem.space.n_dofs)
+    X = problem.space.dof_coordinates
+    top = X[2] > 1.0 - 1e-9
+    top[: 27] = False
+    u[2::3][top] = -0.05
+    contact.active_pairs(u)
+    saved = problem.state()
+    assert saved and all(key.startswith(f"{contact.name}/") for key in saved)
+    problem.terms.insert(0, HyperelasticTerm(problem.space, MaterialRegions(problem.space.mesh, LAW)))
+    assert problem.term_labels()[:2] == ["solid", "solid#2"]
+    assert set(problem.state()) == set(saved)  # the contact's keys did not move
+    before = contact.active_pairs(u)
+    contact.active_pairs(np.zeros_like(u))  # forget
+    problem.restore(saved)
+    after = contact.active_pairs(u)
+    assert before.size and np.array_equal(before.triangle, after.triangle)
+    contact.active_pairs(np.zeros_like(u))
+    index = problem.terms.index(contact)
+    problem.restore({f"{index}/{key.split('/', 1)[1]}": value for key, value in saved.items()})  # format 3
+    assert np.array_equal(contact.active_pairs(u).triangle, before.triangle)
+    with pytest.raises(ValueError, match="no term 'ipc contact'.*solid, solid#2"):
+        problem.restore({"ipc contact/kappa": np.array(1.0)})
+
+
 def test_open_surfaces_have_no_pairs_and_own_neighbourhood_is_excluded():
     problem, contact = block_contact_problem(2, 2, 10.0, gap=0.1)
     assert contact.active_pairs(np.zeros(problem.space.n_dofs)).size == 0

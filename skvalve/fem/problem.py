@@ -326,25 +326,52 @@ class Problem:
         for term in self.terms:
             term.rewind()
 
+    def term_labels(self) -> list[str]:
+        """Each term's label in :meth:`state`: its ``name`` (else its class name), with ``#2``, ``#3``, ... on the
+        second, third, ... term of the same name."""
+        labels, seen = [], {}
+        for term in self.terms:
+            name = str(getattr(term, "name", type(term).__name__))
+            seen[name] = seen.get(name, 0) + 1
+            labels.append(name if seen[name] == 1 else f"{name}#{seen[name]}")
+        return labels
+
     def state(self) -> dict[str, np.ndarray]:
-        """Committed state of every term that has one (``term.state()``), keyed ``"<k>/<name>"``."""
+        """Committed state of every term that has one (``term.state()``), keyed ``"<label>/<name>"`` by the term's
+        label (:meth:`term_labels`): adding a term of another name does not move another term's keys."""
         out = {}
-        for k, term in enumerate(self.terms):
+        for label, term in zip(self.term_labels(), self.terms, strict=True):
             getter = getattr(term, "state", None)
             if getter is not None:
                 for name, array in getter().items():
-                    out[f"{k}/{name}"] = np.asarray(array)
+                    out[f"{label}/{name}"] = np.asarray(array)
         return out
 
     def restore(self, state: dict[str, np.ndarray]) -> None:
-        """Give each term back what :meth:`state` took from it (``term.restore(arrays)``), then commit."""
+        """Give each term back what :meth:`state` took from it (``term.restore(arrays)``).
+
+        Keys ``"<k>/<name>"`` with a number ``k`` (states written before the terms were labelled by name) go to the
+        ``k``-th term. A key that names no term of the problem, or state for a term without ``restore``, is an error.
+        """
+        labels = self.term_labels()
+        grouped: dict[int, dict[str, np.ndarray]] = {}
+        for key, value in state.items():
+            label, _, name = key.partition("/")
+            if label.isdigit() and int(label) < len(self.terms):
+                k = int(label)
+            elif label in labels:
+                k = labels.index(label)
+            else:
+                raise ValueError(f"saved term state {key!r}: the problem has no term {label!r} (its terms: "
+                                 f"{', '.join(labels)})")
+            grouped.setdefault(k, {})[name] = value
         for k, term in enumerate(self.terms):
             restore = getattr(term, "restore", None)
-            mine = {key.split("/", 1)[1]: value for key, value in state.items() if key.split("/", 1)[0] == str(k)}
+            mine = grouped.get(k, {})
             if restore is not None:
                 restore(mine)
             elif mine:
-                raise ValueError(f"term {k} ({type(term).__name__}) has saved state but no restore()")
+                raise ValueError(f"term {labels[k]!r} ({type(term).__name__}) has saved state but no restore()")
 
     @property
     def materials(self):

@@ -23,8 +23,11 @@ from .options import CloseOptions
 
 __all__ = ["KeptState", "StateError", "read_state", "write_state"]
 
-#: format version of the kept state; a file of another version is refused
-FORMAT = 3
+#: format version of the kept state; a file of another version is refused. 4: term state keyed by the term's name
+#: (:meth:`~skvalve.fem.problem.Problem.term_labels`); 3 (keyed by the term's position) is still read, and
+#: :meth:`~skvalve.fem.problem.Problem.restore` gives its keys to the terms by position
+FORMAT = 4
+READS = (3, 4)
 _TERM_PREFIX = "term:"
 _CONTROL_SCALARS = ("radius", "shift", "fallback", "steps", "attempts", "retry_below", "retry_after")
 
@@ -93,8 +96,9 @@ def read_state(path: str | Path, input_name: str | None = None, n_dofs: int | No
     if missing:
         raise StateError(f"kept state {path}: not a closure state of this version (missing {', '.join(missing)}; "
                          "states of benchmarks/trivalve_closure.py before skvalve.valve.run are not resumable)")
-    if int(content["format"]) != FORMAT:
-        raise StateError(f"kept state {path}: format {int(content['format'])}, this version reads {FORMAT}")
+    if int(content["format"]) not in READS:
+        raise StateError(f"kept state {path}: format {int(content['format'])}, this version reads "
+                         f"{' and '.join(map(str, READS))}")
     name = str(content["input"])
     if input_name is not None and name != input_name:
         raise StateError(f"kept state {path}: computed from {name!r}, not from {input_name!r}")
