@@ -17,7 +17,8 @@ from skvalve.fem.elements.truss import Truss
 from skvalve.fem.errors import ConvergenceError, StateRefused
 from skvalve.fem.loads import FollowerPressure
 from skvalve.fem.solvers.block_relaxation import BlockRelaxation
-from skvalve.fem.solvers.linsolve import LinearSolver, available_solvers
+from skvalve.fem.solvers.incremental import IncrementalOptions, minimise_step
+from skvalve.fem.solvers.linsolve import LinearSolver, available_solvers, solver_name
 from skvalve.fem.solvers.trust_region import (
     TrustRegionOptions,
     fitted_shift,
@@ -258,6 +259,33 @@ def test_block_relaxation_of_a_hub_keeps_it_balanced_and_the_end_state():
     with pytest.raises(ValueError, match="also acts"):
         face_node = int(np.flatnonzero(np.isclose(problem.space.mesh.p[0], 1.0))[0])  # in a hex and a cable
         BlockRelaxation(problem, problem.space.displacement_dofs(np.array([face_node])).ravel(), [truss])
+
+
+def test_block_relaxation_inside_a_load_step_balances_the_proximal_block_and_keeps_the_minimiser():
+    """Inside a load step of the incremental potential the hub's sweep carries the step's proximal term: at the
+    relaxed state the whole problem's force on the hub (assembled apart) plus w (u - u~) vanishes, and the step's
+    minimiser is the one reached without the sweep."""
+    problem, truss, hub = _tethered_block()
+    n = problem.space.n_dofs
+    inertia, predictor = np.full(n, 0.3), np.zeros(n)
+    hub_dofs = problem.space.displacement_dofs(np.array([hub])).ravel()
+    relax = BlockRelaxation(problem, hub_dofs, [truss], tol=1e-12)
+    u = np.zeros(n)
+    _, values = problem.constrained(1.0)
+    u[problem.pattern.fixed] = values  # the anchor pulled: the hub is out of balance
+    relaxed, info = relax(u, 1.0, proximal=(inertia, predictor))
+    force, _ = problem.assemble(relaxed, 1.0, tangent=False)
+    assert info.iterations > 0 and info.energy_change < 0.0 and info.initial_norm > 1e-3
+    assert np.linalg.norm(force[hub_dofs] + inertia[hub_dofs] * relaxed[hub_dofs]) <= 1e-11
+    opts = IncrementalOptions(rtol=1e-11, reference=1.0)
+    ends = []
+    for sweep in (None, relax):
+        problem, truss, hub = _tethered_block()
+        sweep = None if sweep is None else BlockRelaxation(problem, hub_dofs, [truss], tol=1e-12)
+        end, _, history = minimise_step(problem, np.zeros(n), 0.0, 1.0, predictor, inertia, 1, opts,
+                                        solver_name(None), relax=sweep)
+        ends.append(end)
+    np.testing.assert_allclose(ends[1], ends[0], atol=1e-9 * np.abs(ends[0]).max())
 
 
 def test_fitted_shift_brings_the_node_that_moves_most_to_the_radius():

@@ -11,10 +11,13 @@ Path (:class:`~skvalve.valve.options.StepOptions`): incremental-potential steps
 (:func:`~skvalve.fem.solvers.incremental.minimise_step`) with a viscous pseudo-mass :math:`cV_i/\Delta t`, whose length
 grows after easy steps and halves after failed ones. The line search's merit is the incremental potential plus the
 follower pressure's work along the ray, by the trapezoidal rule (the pressure on the leaflets' open surface has no
-potential). Held load (:class:`~skvalve.valve.options.HoldOptions`, :func:`held_stages`): the energy trust region
-(:func:`~skvalve.fem.solvers.trust_region.trust_region`) at the end time, a *descend* stage of projected steps of up to
-a millimetre until their energy drop stalls, then a *settle* stage on the symmetric tangent with Newton's steps at the
-end, to ``rtol`` (1e-6) of the undamped problem; the chordae branch points are relaxed after every step.
+potential). The chordae branch points are swept to their own balance (with the step's pseudo-mass) on the first
+iterate and after every accepted iteration (:func:`hub_relaxation`): when the papillary tips move, the cables' pull on
+them is most of the residual. Held load (:class:`~skvalve.valve.options.HoldOptions`, :func:`held_stages`): the
+energy trust region (:func:`~skvalve.fem.solvers.trust_region.trust_region`) at the end time, a *descend* stage of
+projected steps of up to a millimetre until their energy drop stalls, then a *settle* stage on the symmetric tangent
+with Newton's steps at the end, to ``rtol`` (1e-6) of the undamped problem; the chordae branch points are relaxed
+after every step.
 
 Output in ``out``: ``state.npz`` after every accepted step (atomic, :mod:`skvalve.valve.state`; ``resume=True``
 continues from it and repeats the uninterrupted run), ``closure.log`` (one line per step), and at the end
@@ -141,6 +144,8 @@ class _Run:
         self.progress = progress
         self.solver = linsolve.solver_name(options.solver)
         self.lines: list[str] = []
+        # the path's sweep over the chordae branch points: to a tenth of what a path step may leave unbalanced
+        self.path_hubs = hub_relaxation(setup, tol=0.1 * options.steps.rtol * setup.load_norm)
 
     # ------------------------------------------------------------ kept state
     def resume(self, kept: KeptState) -> None:
@@ -171,7 +176,7 @@ class _Run:
                                   solver=self.options.solver)
         inertia = inertia_scale * self.setup.volumes
         u, residual, history = minimise_step(self.problem, s.u, s.t, t_new, s.u, inertia,
-                                             s.steps + s.held_steps + 1, opts, self.solver)
+                                             s.steps + s.held_steps + 1, opts, self.solver, relax=self.path_hubs)
         return u, residual, history
 
     def attempt(self, t_new: float, inertia_scale: float, rtol: float, max_iter: int) -> _Outcome | None:
@@ -292,7 +297,7 @@ def held_stages(options: HoldOptions, load_norm: float, solver: str | None = Non
     return [descend, settle]
 
 
-def hub_relaxation(setup: ValveSetup) -> BlockRelaxation | None:
+def hub_relaxation(setup: ValveSetup, tol: float = 1e-9) -> BlockRelaxation | None:
     """The chordae branch points (vertices of no leaflet cell, not prescribed) brought to equilibrium by the cables
     alone with the rest held (:mod:`skvalve.fem.solvers.block_relaxation`): a global step that sees a hub's slack side
     overshoots it, and unbalanced hubs would carry the residual (on the 1.0 diseased valve's held load, without it, 50
@@ -304,7 +309,7 @@ def hub_relaxation(setup: ValveSetup) -> BlockRelaxation | None:
     hubs = np.flatnonzero(~in_cell)
     if hubs.size == 0 or not trusses:
         return None
-    relax = BlockRelaxation(problem, problem.space.displacement_dofs(hubs).ravel(), trusses)
+    relax = BlockRelaxation(problem, problem.space.displacement_dofs(hubs).ravel(), trusses, tol=tol)
     return relax if relax.dofs.size else None
 
 

@@ -9,7 +9,10 @@ the terms that touch them (:class:`BlockRelaxation`), each iteration's step kept
 falls along it (the work of their residual, :func:`~skvalve.fem.solvers.trust_region.work_along`'s Simpson rule), halved
 otherwise. Running it after each accepted step of :func:`~skvalve.fem.solvers.trust_region.trust_region` is a nonlinear
 Gauss–Seidel sweep over the block (nonlinear elimination: Cai & Keyes 2002): it lowers the energy, and the
-equilibrium of the whole problem is unchanged.
+equilibrium of the whole problem is unchanged. Inside a load step of the incremental potential
+(:func:`~skvalve.fem.solvers.incremental.minimise_step`) the block's energy also carries the step's proximal term
+:math:`\tfrac12\sum_i w_i (u_i - \tilde u_i)^2` on its dofs (``proximal=(w, ũ)``), so the sweep lowers that
+step's merit and leaves its minimiser unchanged.
 """
 
 from __future__ import annotations
@@ -76,8 +79,10 @@ class BlockRelaxation:
         self._local[dofs] = np.arange(dofs.size)
         self.nodes = np.unique(dofs // problem.space.dim) if dofs.size else np.zeros(0, dtype=np.int64)
 
-    def residual(self, u: np.ndarray, t: float, tangent: bool = False):
-        """The block's residual (its dofs) and, with ``tangent``, its (n, n) tangent (CSR) from the terms' blocks."""
+    def residual(self, u: np.ndarray, t: float, tangent: bool = False,
+                 proximal: tuple[np.ndarray, np.ndarray] | None = None):
+        """The block's residual (its dofs) and, with ``tangent``, its (n, n) tangent (CSR) from the terms' blocks;
+        ``proximal=(w, center)`` (both (n_dofs,)) adds :math:`w_i (u_i - c_i)` and the diagonal :math:`w_i`."""
         n = self.problem.space.n_dofs
         force = np.zeros(n)
         rows, cols, values = [], [], []
@@ -94,18 +99,24 @@ class BlockRelaxation:
                     cols.append(np.broadcast_to(b, keep.shape)[keep])
                     values.append(block.matrices[keep])
         r = force[self.dofs]
+        if proximal is not None:
+            weights, center = proximal
+            r = r + weights[self.dofs] * (u[self.dofs] - center[self.dofs])
         if not tangent:
             return r, None
         m = self.dofs.size
         K = sp.csr_matrix((np.concatenate(values), (np.concatenate(rows), np.concatenate(cols))), shape=(m, m))
+        if proximal is not None:
+            K = K + sp.diags(proximal[0][self.dofs], format="csr")
         return r, K
 
-    def __call__(self, u: np.ndarray, t: float) -> tuple[np.ndarray, BlockRelaxationResult]:
-        """``u`` with the block relaxed (a copy), and what it took."""
+    def __call__(self, u: np.ndarray, t: float, proximal: tuple[np.ndarray, np.ndarray] | None = None
+                 ) -> tuple[np.ndarray, BlockRelaxationResult]:
+        """``u`` with the block relaxed (a copy), and what it took; ``proximal``: as in :meth:`residual`."""
         u = np.array(u, dtype=float)
         if self.dofs.size == 0:
             return u, BlockRelaxationResult(0, 0.0, 0.0, 0.0)
-        r, K = self.residual(u, t, tangent=True)
+        r, K = self.residual(u, t, tangent=True, proximal=proximal)
         first = float(np.linalg.norm(r))
         total, iteration = 0.0, 0
         dim = self.problem.space.dim
@@ -132,8 +143,8 @@ class BlockRelaxation:
                 trial[self.dofs] += step
                 middle = u.copy()
                 middle[self.dofs] += 0.5 * step
-                r_middle, _ = self.residual(middle, t)
-                r_end, K_end = self.residual(trial, t, tangent=True)
+                r_middle, _ = self.residual(middle, t, proximal=proximal)
+                r_end, K_end = self.residual(trial, t, tangent=True, proximal=proximal)
                 work = work_along(r, r_middle, r_end, step)
                 if work < 0.0 and np.all(np.isfinite(r_end)):
                     accepted = True

@@ -219,11 +219,16 @@ def incremental_potential(problem: Problem, steps=10, *, mass: np.ndarray | None
 
 
 def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: float, predictor: np.ndarray,
-                  inertia: np.ndarray, step: int, opts: IncrementalOptions, solver: str
-                  ) -> tuple[np.ndarray, np.ndarray, list[dict]]:
+                  inertia: np.ndarray, step: int, opts: IncrementalOptions, solver: str,
+                  relax: Callable | None = None) -> tuple[np.ndarray, np.ndarray, list[dict]]:
     """One load step from ``(u_old, t_old)`` to ``t_new``: the minimiser of the incremental potential with the
     diagonal ``inertia`` (:math:`M/h^2`, or any proximal weight) about ``predictor``; returns its state, the static
-    residual there and the iterations' history. Raises :class:`StepFailed` (the caller rewinds the terms)."""
+    residual there and the iterations' history. Raises :class:`StepFailed` (the caller rewinds the terms).
+
+    ``relax``: a :class:`~skvalve.fem.solvers.block_relaxation.BlockRelaxation` run on the first iterate and after
+    every accepted iteration with the step's proximal term (``relax(u, t, proximal=(inertia, predictor))``): a
+    nonlinear Gauss–Seidel sweep over dofs that cheap, stiff terms alone hold (a valve's chordae branch points),
+    which a global step overshoots. It lowers the merit and leaves the step's minimiser unchanged."""
     pattern = problem.pattern
     fixed, free = pattern.fixed, pattern.free
     u = u_old.copy()
@@ -236,6 +241,8 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
     energy_merit = not work
     if opts.predictor and fixed.size and np.any(u[fixed] != u_old[fixed]):
         u = _consistent_predictor(problem, u_old, u, t_new, predictor, inertia, step, solver, energy_merit)
+    if relax is not None:
+        u, _ = relax(u, t_new, proximal=(inertia, predictor))
     residual, tangent = problem.assemble(u, t_new, tangent=True, step=step)
     gradient = residual + inertia * (u - predictor)
 
@@ -304,6 +311,12 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
         if newton and energy_merit and not shifted and np.linalg.norm(accepted[3][free]) > norm:
             newton_allowed = False
         u, residual, tangent, gradient, _ = accepted
+        if relax is not None:
+            relaxed, sweep = relax(u, t_new, proximal=(inertia, predictor))
+            if sweep.iterations:
+                u = relaxed
+                residual, tangent = problem.assemble(u, t_new, tangent=True, step=step)
+                gradient = residual + inertia * (u - predictor)
         short = short + 1 if alpha <= opts.stall_alpha * cap else 0
         if short >= opts.stall_iterations:
             raise StepFailed(f"line search: {short} iterations in a row took at most {opts.stall_alpha:g} of the step "
