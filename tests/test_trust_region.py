@@ -273,8 +273,12 @@ def test_block_relaxation_inside_a_load_step_balances_the_proximal_block_and_kee
     u = np.zeros(n)
     _, values = problem.constrained(1.0)
     u[problem.pattern.fixed] = values  # the anchor pulled: the hub is out of balance
+    _, before = problem.assemble(u, 1.0, tangent=True)
     relaxed, info = relax(u, 1.0, proximal=(inertia, predictor))
-    force, _ = problem.assemble(relaxed, 1.0, tangent=False)
+    force, full = problem.assemble(relaxed, 1.0, tangent=True)
+    partial, reused = problem.assemble(relaxed, 1.0, tangent=True, reuse=before, fresh=relax.terms)
+    np.testing.assert_array_equal(partial, force)  # only the cables touch the hub: their re-assembly suffices
+    assert (problem.tangent_matrix(reused) != problem.tangent_matrix(full)).nnz == 0
     assert info.iterations > 0 and info.energy_change < 0.0 and info.initial_norm > 1e-3
     assert np.linalg.norm(force[hub_dofs] + inertia[hub_dofs] * relaxed[hub_dofs]) <= 1e-11
     opts = IncrementalOptions(rtol=1e-11, reference=1.0)

@@ -204,17 +204,20 @@ class Problem:
         return all(getattr(term, "symmetric", True) for term in self.terms)
 
     def assemble(self, u: np.ndarray, t: float, tangent: bool = True, step: int | None = None,
-                 reuse: Tangent | None = None) -> tuple[np.ndarray, Tangent]:
+                 reuse: Tangent | None = None, fresh=()) -> tuple[np.ndarray, Tangent]:
         """Residual (all dofs) and the terms' contributions at ``u`` and load factor ``t``.
 
-        ``reuse``: contributions of an earlier call at the same ``u``; only load-dependent terms
-        are re-evaluated. ``self.internal_forces`` / ``self.external_forces`` hold the two parts.
+        ``reuse``: contributions of an earlier call at the same ``u``, or at a ``u`` that differs only in dofs that
+        no term but those in ``fresh`` touches (e.g. after a block relaxation of them); only load-dependent terms and
+        the terms in ``fresh`` are re-evaluated. ``self.internal_forces`` / ``self.external_forces`` hold the two
+        parts.
         """
         n = self.space.n_dofs
         internal, external = np.zeros(n), np.zeros(n)
         contributions = []
         for k, term in enumerate(self.terms):
-            if reuse is not None and not getattr(term, "load_dependent", False):
+            if (reuse is not None and not getattr(term, "load_dependent", False)
+                    and not any(term is other for other in fresh)):
                 contribution = reuse.contributions[k]
             else:
                 contribution = term.assemble(u, t, tangent, step)

@@ -226,7 +226,8 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
     residual there and the iterations' history. Raises :class:`StepFailed` (the caller rewinds the terms).
 
     ``relax``: a :class:`~skvalve.fem.solvers.block_relaxation.BlockRelaxation` run on the first iterate and after
-    every accepted iteration with the step's proximal term (``relax(u, t, proximal=(inertia, predictor))``): a
+    every accepted iteration with the step's proximal term (``relax(u, t, proximal=(inertia, predictor))``; only
+    its ``terms`` are assembled again after it): a
     nonlinear Gauss–Seidel sweep over dofs that cheap, stiff terms alone hold (a valve's chordae branch points),
     which a global step overshoots. It lowers the merit and leaves the step's minimiser unchanged."""
     pattern = problem.pattern
@@ -313,9 +314,10 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
         u, residual, tangent, gradient, _ = accepted
         if relax is not None:
             relaxed, sweep = relax(u, t_new, proximal=(inertia, predictor))
-            if sweep.iterations:
+            if sweep.iterations:  # only the block's terms touch the dofs it moved
                 u = relaxed
-                residual, tangent = problem.assemble(u, t_new, tangent=True, step=step)
+                residual, tangent = problem.assemble(u, t_new, tangent=True, step=step, reuse=tangent,
+                                                     fresh=relax.terms)
                 gradient = residual + inertia * (u - predictor)
         short = short + 1 if alpha <= opts.stall_alpha * cap else 0
         if short >= opts.stall_iterations:

@@ -105,7 +105,8 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
 
     ``relax``: a :class:`~skvalve.fem.solvers.block_relaxation.BlockRelaxation` (``relax(u, t) -> (u, result)``, the
     result with ``iterations`` and ``energy_change``) run before the first step and after each accepted one (e.g. the
-    chordae branch points brought to equilibrium with the rest held); its energy change is added to the step's.
+    chordae branch points brought to equilibrium with the rest held; only its ``terms`` are assembled again after
+    it); its energy change is added to the step's.
 
     ``limit``: ``limit(u, p) -> f`` in (0, 1], the fraction of a step ``p`` (already held to the radius) that may be
     taken (e.g. :func:`~skvalve.fem.contact.clearance.clearance_fraction`: no node carried through a contact sheet);
@@ -328,9 +329,10 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             if relax is not None:
                 clock = time.perf_counter()
                 relaxed, inner = relax(u, t)
-                if inner.iterations:
+                if inner.iterations:  # only the block's terms touch the dofs it moved
                     u = relaxed
-                    residual, tangent = problem.assemble(u, t, tangent=True, step=step)
+                    residual, tangent = problem.assemble(u, t, tangent=True, step=step, reuse=tangent,
+                                                         fresh=relax.terms)
                     problem.commit()
                     problem.check_state(u, t)
                     work += inner.energy_change
