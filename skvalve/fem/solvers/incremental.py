@@ -227,9 +227,9 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
 
     ``relax``: a :class:`~skvalve.fem.solvers.block_relaxation.BlockRelaxation` run on the first iterate and after
     every accepted iteration with the step's proximal term (``relax(u, t, proximal=(inertia, predictor))``; only
-    its ``terms`` are assembled again after it): a
-    nonlinear Gauss–Seidel sweep over dofs that cheap, stiff terms alone hold (a valve's chordae branch points),
-    which a global step overshoots. It lowers the merit and leaves the step's minimiser unchanged."""
+    its ``terms`` are assembled again after it): a nonlinear Gauss–Seidel sweep over dofs that cheap, stiff terms
+    alone hold (a valve's chordae branch points), which a global step overshoots. It lowers the merit and leaves the
+    step's minimiser unchanged."""
     pattern = problem.pattern
     fixed, free = pattern.fixed, pattern.free
     u = u_old.copy()
