@@ -376,3 +376,24 @@ def test_incremental_step_with_mass_is_implicit_euler(velocity):
     balance = residual[free] + mass[free] * (u2 - predictor)[free] / h ** 2
     assert np.linalg.norm(balance) <= 1e-9 * np.linalg.norm(residual[free])
     assert np.linalg.norm(residual[free]) > 1e-6  # the inertia carries part of the load: not the static state
+
+
+def test_a_move_longer_than_the_reach_is_checked_on_its_first_part():
+    """A trial on which a vertex travels farther than ``reach`` (CCD_REACH_EDGES mean edge lengths) is swept only up to
+    there: free there, the share is reach/move; hitting the other block within it, 0.9 of the first contact's share of
+    the whole move, the first contact taken from ipctk's collision-free step of a hundredth of that move."""
+    mesh = _two_blocks(0.02)
+    space = Space(mesh)
+    contact = IPCContact(space, dhat=0.005, stiffness=50.0)
+    upper = mesh.p[2] > 0.5 + 1e-9
+    n, zero = space.n_dofs, np.zeros(space.n_dofs)
+    away = np.zeros(n)
+    away[2::3][upper] = 100.0 * contact.reach  # upwards, away from the lower block: free but very long
+    assert contact.step_fraction(zero, 0.0, away, 0.0) == pytest.approx(0.01, rel=1e-12)
+    down = np.zeros(n)
+    down[2::3][upper] = -0.03 * (1.0 + 0.2 * mesh.p[0][upper])  # a tilting move through the 0.02 gap
+    first = float(ipctk.compute_collision_free_stepsize(contact.mesh, contact.positions(zero, 0.0),
+                                                        contact.positions(down, 0.0)))
+    assert 0.3 < first < 1.0
+    contact.reach = 0.1  # a hundredfold move then reaches 0.1 of 3.6: its first contact lies within the reach
+    assert contact.step_fraction(zero, 0.0, 100.0 * down, 0.0) == pytest.approx(0.9 * first / 100.0, rel=1e-2)
