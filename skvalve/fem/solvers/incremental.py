@@ -236,7 +236,8 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
     _, values = problem.constrained(t_new)
     u[fixed] = values
     if problem.step_fraction(u_old, t_old, u, t_new) < 1.0:
-        raise StepFailed(f"the prescribed motion from load factor {t_old:.6g} to {t_new:.6g} is not collision-free")
+        raise StepFailed(f"the prescribed motion from load factor {t_old:.6g} to {t_new:.6g} is not collision-free "
+                         "(or moves a surface vertex farther than one CCD sweep reaches)")
 
     work = problem.work_terms(u, t_new)  # terms without a potential: their work is integrated along each ray
     energy_merit = not work

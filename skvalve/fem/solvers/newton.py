@@ -171,7 +171,8 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
     if t_new != t_old and problem.step_fraction(u_old, t_old, u, t_new) < 1.0:
         # the prescribed motion alone (supports, kinematic obstacles) would carry a surface through another: a
         # shorter load step, not a shorter Newton step, is what can avoid it
-        raise _StepFailed(f"the prescribed motion from load factor {t_old:.6g} to {t_new:.6g} is not collision-free")
+        raise _StepFailed(f"the prescribed motion from load factor {t_old:.6g} to {t_new:.6g} is not collision-free "
+                          "(or moves a surface vertex farther than one CCD sweep reaches)")
     if free.size == 0:  # every dof prescribed: the state is known, the residual gives the reactions
         residual, tangent = problem.assemble(u, t_new, tangent=True, step=step)
         return u, residual, [], tangent
