@@ -155,16 +155,21 @@ def test_contact_tangent_matches_central_differences_with_fixed_active_set():
     assert np.allclose(K, K.T)
 
 
+def _upper_block_pressed(problem) -> np.ndarray:
+    """A displacement that presses the upper block's bottom face 0.05 into the lower block (non-matching faces)."""
+    u = np.zeros(problem.space.n_dofs)
+    top = problem.space.dof_coordinates[2] > 1.0 - 1e-9
+    top[: 27] = False
+    u[2::3][top] = -0.05
+    return u
+
+
 def test_the_search_memory_saved_with_a_state_gives_back_its_active_set():
     """Non-matching faces (2 on 3 cells): nodes of one face sit on edges of the other's triangles, where the search
     keeps the triangle of its last search. The memory taken by ``state`` and given back by ``restore`` after other
     searches (here one at the open state, which forgets every pair) reproduces the active set at the same ``u``."""
     problem, contact = block_contact_problem(2, 3, 30.0)
-    u = np.zeros(problem.space.n_dofs)
-    X = problem.space.dof_coordinates
-    top = X[2] > 1.0 - 1e-9
-    top[: 27] = False
-    u[2::3][top] = -0.05
+    u = _upper_block_pressed(problem)
     u += 0.01 * _random_state(2).normal(size=u.size)
     before = contact.active_pairs(u)
     memory = contact.state()
@@ -183,11 +188,7 @@ def test_problem_state_is_keyed_by_term_name():
     term of the same name is ``name#2``; positional keys (kept states of format 3) still restore; a key that names no
     term is refused, naming it."""
     problem, contact = block_contact_problem(2, 3, 30.0)
-    u = np.zeros(problem.space.n_dofs)
-    X = problem.space.dof_coordinates
-    top = X[2] > 1.0 - 1e-9
-    top[: 27] = False
-    u[2::3][top] = -0.05
+    u = _upper_block_pressed(problem)
     contact.active_pairs(u)
     saved = problem.state()
     assert saved and all(key.startswith(f"{contact.name}/") for key in saved)
