@@ -115,15 +115,16 @@ def test_a_step_far_past_the_minimum_is_moved_onto_it():
     accepted = (full, problem.assemble(full, 0.0)[0], None, problem.assemble(full, 0.0)[0], problem.energy(full))
     assert accepted[4] <= value + 1e-4 * slope  # Armijo accepts the overshoot
     merit = lambda alpha, state, contributions: problem.energy(state)
-    alpha, refined = _past_the_minimum(problem, u, p, 1.0, slope, value, accepted, 0.0, 1, np.zeros(3), u, merit,
-                                       IncrementalOptions())
+    alpha, refined = _past_the_minimum(problem, lambda a: u + a * p, p, 1.0, slope, value, accepted, 0.0, 1,
+                                       np.zeros(3), u, merit, IncrementalOptions())
     assert alpha == pytest.approx(1.0 / 1.95, rel=1e-12)
     np.testing.assert_allclose(refined[0], target, atol=1e-12)
     # a step that stops short of the minimum is left as it is
     short = u + 0.5 * (target - u)
     kept = (short, problem.assemble(short, 0.0)[0], None, problem.assemble(short, 0.0)[0], problem.energy(short))
-    assert _past_the_minimum(problem, u, target - u, 0.5, float(gradient @ (target - u)), value, kept, 0.0, 1,
-                             np.zeros(3), u, merit, IncrementalOptions())[0] == 0.5
+    towards = target - u
+    assert _past_the_minimum(problem, lambda a: u + a * towards, towards, 0.5, float(gradient @ towards), value, kept,
+                             0.0, 1, np.zeros(3), u, merit, IncrementalOptions())[0] == 0.5
 
 
 def _pressed_block(direction: str):
@@ -194,3 +195,30 @@ def test_a_follower_pressure_step_is_minimised_along_each_ray_to_newtons_equilib
     records = [record for step in minimised.histories for record in step]
     assert not any(record["energy_merit"] for record in records)
     assert records[-1]["newton"] and records[-1]["alpha"] == 1.0
+
+
+def test_line_search_trials_are_assembled_without_their_tangent_and_the_accepted_state_last():
+    """A trial's tangent is assembled only once it is accepted (a rejected trial costs a residual), and the state a
+    term saw last before each commit is the accepted one (the barrier's commit takes the state it saw last)."""
+    solid, contact, _ = _block_over_obstacle(drop=0.1, gap=0.05, dhat=0.02, rollers=True)
+    calls, commits = [], []
+    assemble, commit = contact.assemble, contact.commit
+
+    def counted_assemble(u, t, tangent, step):
+        calls.append((np.array(u, copy=True), tangent))
+        return assemble(u, t, tangent, step)
+
+    def checked_commit():
+        commits.append(calls[-1][0])
+        commit()
+
+    contact.assemble, contact.commit = counted_assemble, checked_commit
+    result = incremental_potential(solid, steps=2, options=IncrementalOptions(rtol=1e-10, atol=1e-12),
+                                   progress=False)
+    iterations = sum(map(len, result.histories))
+    with_tangent = sum(tangent for _, tangent in calls)
+    # per step: the predictor's tangent at the old state and the first iterate's; then one per accepted iteration
+    assert with_tangent == 2 * (len(result.histories) - 1) + iterations
+    assert len(calls) - with_tangent > len(result.histories)  # rejected trials and residual-only evaluations happened
+    for state, solution in zip(commits[1:], result.solutions[1:], strict=True):
+        np.testing.assert_array_equal(state, solution)

@@ -282,14 +282,17 @@ def test_block_relaxation_inside_a_load_step_balances_the_proximal_block_and_kee
     assert info.iterations > 0 and info.energy_change < 0.0 and info.initial_norm > 1e-3
     assert np.linalg.norm(force[hub_dofs] + inertia[hub_dofs] * relaxed[hub_dofs]) <= 1e-11
     opts = IncrementalOptions(rtol=1e-11, reference=1.0)
-    ends = []
+    ends, counts = [], []
     for with_sweep in (False, True):
         problem, truss, hub = _tethered_block()
         sweep = BlockRelaxation(problem, hub_dofs, [truss], tol=1e-12) if with_sweep else None
-        end, _, _ = minimise_step(problem, np.zeros(n), 0.0, 1.0, predictor, inertia, 1, opts, solver_name(None),
-                                  relax=sweep)
+        end, _, history = minimise_step(problem, np.zeros(n), 0.0, 1.0, predictor, inertia, 1, opts,
+                                        solver_name(None), relax=sweep)
         ends.append(end)
+        counts.append(len(history))
     np.testing.assert_allclose(ends[1], ends[0], atol=1e-9 * np.abs(ends[0]).max())
+    # the line search's trials carry the sweep too (the hub re-minimised on each): no more iterations than without
+    assert counts[1] <= counts[0], counts
 
 
 def test_fitted_shift_brings_the_node_that_moves_most_to_the_radius():
@@ -508,9 +511,10 @@ def test_each_steps_energy_change_is_the_drop_of_the_total_potential():
     start[block.pattern.fixed] = block.constrained(1.0)[1]
     energies = [block.energy(state, 1.0) for state in [start, *states]]
     drops = np.diff(energies)
-    assert np.all(drops < 0.0)
     resolved = np.abs(drops) > 1e-8 * abs(energies[-1])
-    assert resolved.sum() >= 5
+    assert resolved.sum() >= 5 and np.all(drops[resolved] < 0.0)
+    # the last steps' changes are lost in the energy's rounding (the residual's fall accepts them): none rises past it
+    assert np.all(drops <= 1e-12 * abs(energies[-1]))
     np.testing.assert_allclose(np.array(result.energy_changes)[resolved], drops[resolved], rtol=1e-9)
 
 

@@ -31,7 +31,7 @@ from numba import njit, prange
 # runtimes when they start (first parallel call), so set at import; an explicit user setting wins.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
-__all__ = ["element_gradients", "element_stiffness", "element_forces", "scatter_add", "csr_pattern"]
+__all__ = ["element_gradients", "element_stiffness", "element_forces", "scatter_add", "csr_pattern", "psd_blocks"]
 
 
 @njit(parallel=True, cache=True)
@@ -195,3 +195,29 @@ def csr_pattern(element_dofs: np.ndarray, n: int):
                         hi = mid
                 positions[e, m, k] = lo
     return indptr, indices, positions
+
+
+@njit(parallel=True, cache=True)
+def psd_blocks(matrices):
+    r"""Each (m, m) block's symmetric part :math:`S = \tfrac12 (B + B^T)` with its negative eigenvalues set to zero,
+    :math:`\sum_{\lambda_k > 0} \lambda_k v_k v_k^T` (the nearest positive semidefinite matrix in the Frobenius norm);
+    a block with no negative eigenvalue is returned as :math:`S` itself. One pass per block, in parallel: the batched
+    NumPy version (symmetric part, ``eigh``, reconstruction by a batched product) took 1.3-1.9 s on the 18 920 F-bar
+    blocks of the Texas TriValve, most of it outside the eigensolver."""
+    n, m = matrices.shape[0], matrices.shape[1]
+    out = np.empty_like(matrices)
+    for e in prange(n):
+        S = 0.5 * (matrices[e] + matrices[e].T)
+        values, vectors = np.linalg.eigh(S)
+        if values[0] >= 0.0:
+            out[e] = S
+            continue
+        for i in range(m):
+            for j in range(i, m):
+                acc = 0.0
+                for k in range(m):
+                    if values[k] > 0.0:
+                        acc += vectors[i, k] * values[k] * vectors[j, k]
+                out[e, i, j] = acc
+                out[e, j, i] = acc
+    return out

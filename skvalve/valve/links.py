@@ -48,10 +48,12 @@ from ..fem.space import Space
 from ..io.abaqus import AbaqusModel, Location
 from ..materials.uniaxial import LinearUniaxial
 
-__all__ = ["LINK_FACTOR", "Links", "link_nodes", "link_constraints"]
+__all__ = ["LINK_FACTOR", "LINK_TERM", "Links", "link_nodes", "link_constraints"]
 
 #: Axial rigidity of a LINK bar over that of the stiffest chord (module docstring: tolerance).
 LINK_FACTOR = 1.0e3
+#: The name of the links' :class:`~skvalve.fem.elements.truss.Truss` term
+LINK_TERM = "links"
 
 
 @dataclass
@@ -75,7 +77,7 @@ class Links:
 
     def term(self, space: Space) -> Truss:
         """The penalty bars as a :class:`~skvalve.fem.elements.truss.Truss` term (unit area, modulus :math:`EA`)."""
-        return Truss(space, self.ends, 1.0, LinearUniaxial(self.rigidity), rest_length=self.length, name="links")
+        return Truss(space, self.ends, 1.0, LinearUniaxial(self.rigidity), rest_length=self.length, name=LINK_TERM)
 
     def subset(self, new_index: np.ndarray) -> Links:
         """The links whose two ends survive a renumbering ``new_index`` (-1 = dropped vertex)."""

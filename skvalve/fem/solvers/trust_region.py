@@ -280,7 +280,8 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             clock = time.perf_counter()
             try:
                 middle, middle_tangent = _residual(problem, u + 0.5 * p, t, step)
-                trial_residual, trial_tangent = problem.assemble(u + p, t, tangent=True, step=step)
+                # the residual only: the tangent (most of an assembly's cost) is assembled once the step is accepted
+                trial_residual, trial_tangent = problem.assemble(u + p, t, tangent=False, step=step)
                 if not np.all(np.isfinite(trial_residual)):
                     raise _Attempt("the residual is not finite")
                 trial_energy = problem.potential_energy(u + p, t, skip=work_terms)
@@ -321,6 +322,9 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                           f"{largest:.3g}; radius {radius:.3g} shift {shift:.3g}; {carriers.size} nodes carry 90 % "
                           f"of the rise{f' (first {carriers[:5].tolist()})' if carriers.size else ''}", flush=True)
                 continue
+            clock = time.perf_counter()
+            trial_residual, trial_tangent = problem.assemble(u + p, t, tangent=True, step=step)  # the last assembled
+            result.timings["assembly"] += time.perf_counter() - clock
             problem.commit()
             local *= opts.local_decay
             local[local < opts.min_shift] = 0.0
@@ -402,16 +406,18 @@ def _newton_try(problem, solver, K, residual, u, t, step, radius, norm, opts, re
         p *= fraction
         largest *= fraction
     clock = time.perf_counter()
-    try:
-        trial, tangent = problem.assemble(u + p, t, tangent=True, step=step)
+    try:  # the residual first: the tangent only for a try that is taken
+        trial, _ = problem.assemble(u + p, t, tangent=False, step=step)
         problem.check_state(u + p, t)
     except (NonPositiveJacobianError, StateRefused):
         trial = None
-    result.timings["assembly"] += time.perf_counter() - clock
     if trial is None or not np.all(np.isfinite(trial)) or \
             np.linalg.norm(trial[free]) > opts.newton_decrease * norm:
+        result.timings["assembly"] += time.perf_counter() - clock
         problem.rewind()
         return None
+    trial, tangent = problem.assemble(u + p, t, tangent=True, step=step)
+    result.timings["assembly"] += time.perf_counter() - clock
     return p, trial, tangent, 0.5 * float((residual[free] + trial[free]) @ p[free]), largest
 
 

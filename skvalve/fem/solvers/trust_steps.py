@@ -14,21 +14,40 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
+from ..kernels import psd_blocks
 from ..problem import Problem, Tangent
 from . import linsolve
 
-__all__ = ["project_psd", "shift_psd", "project_sparse_psd", "step_matrix", "fitted_shift", "fit_radius",
-           "shifted_direction", "factorize_counted", "largest_motion", "on_all_dofs", "FIT_ABOVE"]
+__all__ = ["project_psd", "projected_tangent", "shift_psd", "project_sparse_psd", "step_matrix", "fitted_shift",
+           "fit_radius", "shifted_direction", "factorize_counted", "largest_motion", "on_all_dofs", "FIT_ABOVE"]
 
 
 def project_psd(matrices: np.ndarray) -> np.ndarray:
     """Each (m, m) block's symmetric part with its negative eigenvalues set to zero (the nearest positive
     semidefinite matrix in the Frobenius norm)."""
-    symmetric = 0.5 * (matrices + np.swapaxes(matrices, -1, -2))
+    blocks = np.asarray(matrices, dtype=float)
+    if blocks.ndim == 3 and blocks.shape[0]:
+        return psd_blocks(np.ascontiguousarray(blocks))  # compiled, block by block (kernels.psd_blocks)
+    symmetric = 0.5 * (blocks + np.swapaxes(blocks, -1, -2))
     values, vectors = np.linalg.eigh(symmetric)
     if np.all(values >= 0.0):
         return symmetric
     return (vectors * np.maximum(values, 0.0)[..., None, :]) @ np.swapaxes(vectors, -1, -2)
+
+
+def projected_tangent(problem: Problem, tangent: Tangent) -> sp.csr_matrix:
+    """The free-dof tangent with every symmetric term's element blocks projected onto their PSD parts, a term's own
+    projected sparse matrix where it gives one (contact stencils) and the symmetric part of everything else."""
+
+    def blocks(term, matrices):
+        if getattr(term, "symmetric", True):
+            return project_psd(matrices)
+        return 0.5 * (matrices + np.swapaxes(matrices, -1, -2))
+
+    def matrix(term, sparse):
+        return 0.5 * (sparse + sparse.T)
+
+    return problem.tangent_matrix(tangent, blocks=blocks, matrix=matrix, projected=True).tocsr()
 
 
 def shift_psd(matrices: np.ndarray) -> np.ndarray:
