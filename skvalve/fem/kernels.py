@@ -201,9 +201,9 @@ def csr_pattern(element_dofs: np.ndarray, n: int):
 def psd_blocks(matrices):
     r"""Each (m, m) block's symmetric part :math:`S = \tfrac12 (B + B^T)` with its negative eigenvalues set to zero,
     :math:`\sum_{\lambda_k > 0} \lambda_k v_k v_k^T` (the nearest positive semidefinite matrix in the Frobenius norm);
-    a block with no negative eigenvalue is returned as :math:`S` itself. One pass per block, in parallel: the batched
-    NumPy version (symmetric part, ``eigh``, reconstruction by a batched product) took 1.3-1.9 s on the 18 920 F-bar
-    blocks of the Texas TriValve, most of it outside the eigensolver."""
+    a block with no negative eigenvalue is returned as :math:`S` itself. One pass per block, in parallel over the
+    blocks (the batched NumPy version loops over them on one thread); on one thread 5000 random 24 x 24 blocks took
+    0.27 s against NumPy's 0.30 s, most of it in the eigensolver."""
     n, m = matrices.shape[0], matrices.shape[1]
     out = np.empty_like(matrices)
     for e in prange(n):

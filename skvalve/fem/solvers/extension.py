@@ -49,11 +49,9 @@ class MotionExtension:
     def __init__(self, problem: Problem, terms: Sequence[Term], solver: str | None = None) -> None:
         if not terms:
             raise ValueError("MotionExtension needs at least one term whose elements carry the motion")
-        self.problem = problem
-        self.terms = tuple(terms)
         dim, n = problem.space.dim, problem.space.n_dofs
         rows, cols = [], []
-        for term in self.terms:
+        for term in terms:
             for connectivity in term.connectivity():
                 dofs = np.asarray(connectivity, dtype=np.int64)
                 if dofs.size == 0:

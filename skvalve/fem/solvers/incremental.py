@@ -235,9 +235,11 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
     work = problem.work_terms(u_old, t_new)
     energy_merit = not work
     moved = bool(fixed.size and np.any(u[fixed] != u_old[fixed]))
+    collision_free = problem.step_fraction(u_old, t_old, u, t_new) >= 1.0
     if moved and carry is not None:
-        u = carried_start(problem, u_old, t_old, u, t_new, carry(u_old, u), predictor, inertia, step, energy_merit)
-    if problem.step_fraction(u_old, t_old, u, t_new) < 1.0:
+        u, collision_free = carried_start(problem, u_old, t_old, u, collision_free, t_new, carry(u_old, u), predictor,
+                                          inertia, step, energy_merit)
+    if not collision_free:
         raise StepFailed(f"the prescribed motion from load factor {t_old:.6g} to {t_new:.6g} is not collision-free "
                          "(or moves a surface vertex farther than one CCD sweep reaches)")
     if opts.predictor and moved:

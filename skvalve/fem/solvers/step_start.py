@@ -67,17 +67,17 @@ def step_merit(problem: Problem, state: np.ndarray, t: float, predictor: np.ndar
     return value if math.isfinite(value) else float("inf")
 
 
-def carried_start(problem: Problem, u_old: np.ndarray, t_old: float, u: np.ndarray, t_new: float,
+def carried_start(problem: Problem, u_old: np.ndarray, t_old: float, u: np.ndarray, alone_free: bool, t_new: float,
                   carried: np.ndarray, predictor: np.ndarray, inertia: np.ndarray, step: int,
-                  energy_merit: bool) -> np.ndarray:
-    """``carried`` (the free dofs moved by the prescribed increment's extension) where its motion from ``u_old`` is
-    collision-free and either the move of ``u`` (the prescribed dofs moved alone) is not or the step's merit is lower
-    at ``carried``; else ``u``."""
+                  energy_merit: bool) -> tuple[np.ndarray, bool]:
+    """``(start, collision_free)``: ``carried`` (the free dofs moved by the prescribed increment's extension) where its
+    motion from ``u_old`` is collision-free and either the move to ``u`` (the prescribed dofs moved alone; its CCD
+    verdict ``alone_free``) is not or the step's merit is lower at ``carried``; else ``u`` and ``alone_free``."""
     if np.array_equal(carried, u) or problem.step_fraction(u_old, t_old, carried, t_new) < 1.0:
-        return u
-    if problem.step_fraction(u_old, t_old, u, t_new) < 1.0:
+        return u, alone_free
+    if not alone_free:
         logger.debug("step %d: carried (the prescribed dofs moved alone are not collision-free)", step)
-        return carried
+        return carried, True
     merits = [step_merit(problem, state, t_new, predictor, inertia, step, energy_merit) for state in (u, carried)]
     logger.debug("step %d: merit %.3e with the prescribed dofs moved alone, %.3e carried", step, *merits)
-    return carried if merits[1] < merits[0] else u
+    return (carried if merits[1] < merits[0] else u), True
