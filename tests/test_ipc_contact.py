@@ -24,6 +24,7 @@ from skvalve.fem.contact.ipc import Friction
 from skvalve.fem.meshes import box
 from skvalve.fem.solvers.incremental import IncrementalOptions, incremental_potential
 from skvalve.fem.solvers.ptc import PseudoTransientOptions, pseudo_transient
+from skvalve.fem.solvers.trust_steps import project_sparse_psd, step_matrix
 from skvalve.materials import NeoHookean
 
 MATERIAL = NeoHookean.from_shear_poisson(G=10.0, nu=0.3)
@@ -397,3 +398,31 @@ def test_a_move_longer_than_the_reach_is_checked_on_its_first_part():
     assert 0.3 < first < 1.0
     contact.reach = 0.1  # a hundredfold move then reaches 0.1 of 3.6: its first contact lies within the reach
     assert contact.step_fraction(zero, 0.0, 100.0 * down, 0.0) == pytest.approx(0.9 * first / 100.0, rel=1e-2)
+
+
+def test_the_trust_regions_step_matrix_projects_the_barrier_stencil_by_stencil():
+    """``step_matrix`` with the contact named for projection (the valve's settle stage) is the symmetric tangent with
+    the barrier's exact Hessian replaced by ipctk's per-stencil projection (the term's ``projected_matrix``), not by
+    the projection of each connected patch as a whole: the two differ here, and only the per-stencil one is what
+    the load path's projected steps use."""
+    mesh = _two_blocks(0.02)
+    solid = Solid(mesh, MATERIAL)
+    contact = IPCContact(solid.space, dhat=0.05, stiffness=50.0)
+    solid.add_term(contact)
+    u = 2e-3 * np.random.default_rng(7).standard_normal(solid.space.n_dofs)
+    assert contact.active_pairs(u, 0.0) > 10
+    _, tangent = solid.assemble(u, 0.0, tangent=True)
+    own = contact.assemble(u, 0.0, True, None)
+    free = solid.pattern.free
+
+    def on_free(matrix):
+        return (0.5 * (matrix + matrix.T)).tocsr()[free][:, free].toarray()
+
+    plain = step_matrix(solid, tangent, False).toarray()
+    stencils = step_matrix(solid, tangent, False, (contact.name,)).toarray()
+    expected = plain - on_free(own.matrix) + on_free(own.projected_matrix)
+    np.testing.assert_allclose(stencils, expected, atol=1e-12 * np.abs(expected).max())
+    patches = plain - on_free(own.matrix) + on_free(project_sparse_psd(own.matrix))
+    assert np.abs(stencils - patches).max() > 1e-6 * np.abs(on_free(own.matrix)).max()
+    everything = step_matrix(solid, tangent, True).toarray()  # the descend stage takes the stencils' projection too
+    assert np.linalg.eigvalsh(everything).min() >= -1e-9 * np.abs(everything).max()

@@ -163,8 +163,9 @@ class HoldOptions:
 
     1. *descend*: steps on the element-projected tangent under Marquardt's diagonal shift, up to ``max_radius`` on any
        node, until their energy drop stalls (the last 20 steps' average below ``stall_fraction`` of the stage's);
-    2. *settle*: the symmetric tangent itself, with a uniform (Levenberg) shift fitted to the radius and the contact's
-       indefinite blocks shifted locally, and below ``newton_below`` Newton's step with the full tangent, to ``rtol``.
+    2. *settle*: the symmetric tangent itself, with a uniform (Levenberg) shift fitted to the radius and the
+       contact's stencils projected one by one (IPC's own projection: the sliding directions of a contact patch stay
+       soft), and below ``newton_below`` Newton's step with the full tangent, to ``rtol``.
 
     Why not the path's damped steps held at the end load (the method before): their pseudo-mass caps a leaflet's speed
     at about :math:`p/(c h)` (15 mm per unit step time on the 1.0 valve), and on the 1.0 diseased valve's held load,

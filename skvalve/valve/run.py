@@ -36,6 +36,7 @@ from typing import NamedTuple
 import numpy as np
 from tqdm.auto import tqdm
 
+from ..fem.contact import IPCContact
 from ..fem.elements.fbar import FBarTerm
 from ..fem.elements.truss import Truss
 from ..fem.errors import ConvergenceError, NonPositiveJacobianError, SingularSystemError, SolverError, StateRefused
@@ -291,13 +292,13 @@ class _Run:
 def held_stages(options: HoldOptions, load_norm: float, solver: str | None = None) -> list[TrustRegionOptions]:
     """The held load's two trust-region stages (:class:`~skvalve.valve.options.HoldOptions`): *descend* (projected
     step matrix, Marquardt's diagonal shift, steps scaled into the radius, until the energy drop stalls) and *settle*
-    (the symmetric tangent, a uniform shift fitted to the radius, the IPC contact's indefinite blocks shifted locally,
+    (the symmetric tangent, a uniform shift fitted to the radius, the IPC contact's stencils projected one by one,
     Newton's full-tangent steps below ``newton_below``); residuals relative to the end load's nodal forces."""
     common = {"radius": 0.25 * options.max_radius, "max_radius": options.max_radius, "rtol": options.rtol,
               "reference": load_norm, "max_steps": options.max_steps, "max_strain_increment": None,
               "newton_below": options.newton_below, "solver": solver}
     descend = TrustRegionOptions(project=True, stall_fraction=options.stall_fraction, **common)
-    settle = TrustRegionOptions(project=False, fit_radius=3, shift_scaling="uniform", shift_terms=("ipc contact",),
+    settle = TrustRegionOptions(project=False, fit_radius=3, shift_scaling="uniform", project_terms=(IPCContact.name,),
                                 **common)
     return [descend, settle]
 
