@@ -14,6 +14,7 @@ import scipy.sparse as sp
 from test_ipc_contact import _block_over_obstacle  # the pressed block of the IPC tests
 
 from skvalve.fem import Solid, solve
+from skvalve.fem.errors import ConvergenceError
 from skvalve.fem.meshes import box
 from skvalve.fem.solvers import linsolve
 from skvalve.fem.solvers.incremental import (
@@ -222,3 +223,27 @@ def test_line_search_trials_are_assembled_without_their_tangent_and_the_accepted
     assert len(calls) - with_tangent > len(result.histories)  # rejected trials and residual-only evaluations happened
     for state, solution in zip(commits[1:], result.solutions[1:], strict=True):
         np.testing.assert_array_equal(state, solution)
+
+
+def test_the_iteration_limit_tests_the_last_iterate_and_spares_a_contracting_iteration():
+    """A block stretched in one load step takes ``n`` Newton iterations. With ``max_iter = n`` the step converges
+    (the iterate after the last allowed iteration is tested); with ``max_iter = n - 2`` too, since its last
+    iterations each more than halve |grad E| (``CONTRACTING``); with ``max_iter = 1`` it fails after at most two
+    iterations (the hard cap: twice ``max_iter``)."""
+    def stretched(max_iter):
+        solid = Solid(box((2, 2, 2)), NeoHookean.from_shear_poisson(1.0, 0.3))
+        solid.add_dirichlet("left", 0.0)
+        solid.add_dirichlet("right", [0.8, 0.0, 0.0])
+        options = IncrementalOptions(rtol=1e-10, max_iter=max_iter, max_cutbacks=0, predictor=False)
+        return incremental_potential(solid, steps=1, options=options, progress=False)
+
+    free = stretched(60)
+    residuals = [record["residual"] for record in free.histories[-1]]
+    n = len(residuals)
+    assert n >= 5 and residuals[-1] <= 0.5 * residuals[-2] and residuals[-2] <= 0.5 * residuals[-3], residuals
+    for max_iter in (n, n - 2):
+        capped = stretched(max_iter)
+        assert len(capped.histories[-1]) == n
+        np.testing.assert_array_equal(capped.solutions[-1], free.solutions[-1])
+    with pytest.raises(ConvergenceError, match="2 iterations"):
+        stretched(1)

@@ -129,7 +129,8 @@ class StepOptions:
         (:func:`~skvalve.valve.setup.end_load_norm`, as every relative residual of the closure): a step leaves at
         most this share of the pressure unbalanced; the held load is then solved to ``HoldOptions.rtol``.
     max_iter
-        iterations per step before it is cut back.
+        iterations per step before it is cut back; a step whose iterations still each halve the residual goes on,
+        up to twice as many (:data:`~skvalve.fem.solvers.incremental.CONTRACTING`).
     """
 
     damping: float = 1e-3

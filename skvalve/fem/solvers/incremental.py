@@ -79,6 +79,12 @@ FIRST_SHIFT, SHIFT_GROWTH = 1e-6, 10.0
 #: below this last shift the next iteration tries Newton's step first (else a hundredth of the last shift)
 NEWTON_AGAIN_BELOW = 1e-3
 
+#: Past ``max_iter`` a step goes on (up to twice as many iterations) while each iteration lowers |grad E| to at most
+#: this share: a contracting iteration is not cut back. Before, the residual after the last allowed iteration was not
+#: even tested: on the 1.0 annuloplasty valve a step converging quadratically was cut back after its 40th iteration
+#: with a relative residual of 9.8e-4 against its tolerance of 1e-3.
+CONTRACTING = 0.5
+
 #: Relative size below which a predicted change of the total potential is lost in its rounding (a sum over every
 #: quadrature point and barrier stencil): the line search then asks that the gradient's norm falls instead.
 ENERGY_RESOLUTION = 1e-12
@@ -274,11 +280,15 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
         """The relative residual's force scale: ``opts.reference``, else the reactions' and loads' norm."""
         return opts.reference if opts.reference is not None else reference_force(problem, residual, fixed)
 
-    for iteration in range(1, opts.max_iter + 1):
+    iteration, before = 0, math.inf  # before: |grad E| before the last iteration
+    while True:
         reference = scale(residual)
         norm = float(np.linalg.norm(gradient[free]))
         if norm <= max(opts.rtol * reference, opts.atol):
             return u, residual, history
+        if iteration >= opts.max_iter and not (iteration < 2 * opts.max_iter and norm <= CONTRACTING * before):
+            raise StepFailed(f"no convergence in {iteration} iterations (relative residual {norm / reference:.3e})")
+        iteration, before = iteration + 1, norm
         clock = time.perf_counter()
         if shifted:
             K = problem.tangent_matrix(tangent)
@@ -341,8 +351,6 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
                         "residual": float(np.linalg.norm(gradient[free])),
                         "relative_residual": float(np.linalg.norm(gradient[free])) / reference,
                         "seconds": time.perf_counter() - clock})
-    raise StepFailed(f"no convergence in {opts.max_iter} iterations (relative residual "
-                     f"{float(np.linalg.norm(gradient[free])) / scale(residual):.3e})")
 
 
 @dataclass
