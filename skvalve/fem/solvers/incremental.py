@@ -79,10 +79,10 @@ FIRST_SHIFT, SHIFT_GROWTH = 1e-6, 10.0
 #: below this last shift the next iteration tries Newton's step first (else a hundredth of the last shift)
 NEWTON_AGAIN_BELOW = 1e-3
 
-#: Past ``max_iter`` a step goes on (up to twice as many iterations) while each iteration lowers |grad E| to at most
-#: this share: a contracting iteration is not cut back. Before, the residual after the last allowed iteration was not
-#: even tested: on the 1.0 annuloplasty valve a step converging quadratically was cut back after its 40th iteration
-#: with a relative residual of 9.8e-4 against its tolerance of 1e-3.
+#: Past ``max_iter`` a step goes on (up to twice as many iterations) while each iteration lowers the gradient norm
+#: to at most this share: a contracting iteration is not cut back. Before, the residual after the last allowed
+#: iteration was not even tested: on the 1.0 annuloplasty valve a step converging quadratically was cut back after
+#: its 40th iteration with a relative residual of 9.8e-4 against its tolerance of 1e-3.
 CONTRACTING = 0.5
 
 #: Relative size below which a predicted change of the total potential is lost in its rounding (a sum over every
