@@ -424,5 +424,5 @@ def test_the_trust_regions_step_matrix_projects_the_barrier_stencil_by_stencil()
     np.testing.assert_allclose(stencils, expected, atol=1e-12 * np.abs(expected).max())
     patches = plain - on_free(own.matrix) + on_free(project_sparse_psd(own.matrix))
     assert np.abs(stencils - patches).max() > 1e-6 * np.abs(on_free(own.matrix)).max()
-    everything = step_matrix(solid, tangent, True).toarray()  # the descend stage takes the stencils' projection too
+    everything = step_matrix(solid, tangent, True).toarray()  # every term projected (the descend stage): semidefinite
     assert np.linalg.eigvalsh(everything).min() >= -1e-9 * np.abs(everything).max()
