@@ -29,20 +29,24 @@ class TrustRegionOptions:
         The first shift :math:`\alpha` (relative to the tangent's diagonal), the value below which it becomes 0, and
         the value above which the solver gives up.
     project : bool
-        Project each element block of the symmetric terms (solids, trusses), and each connected block of an extra
-        sparse matrix (contact), onto its positive semidefinite part in :math:`H` (the model :math:`m` of the
-        steps that are not Newton's).
+        Project each element block of the symmetric terms (solids, trusses), and an extra sparse matrix (contact),
+        onto its positive semidefinite part in :math:`H` (the model :math:`m` of the steps that are not Newton's):
+        the term's own projection where it gives one (an IPC barrier's, stencil by stencil), else each connected
+        block's (:func:`~skvalve.fem.solvers.trust_steps.step_matrix`).
     project_terms : tuple of str
         Names of terms (``Term.name``) whose element blocks are projected even when ``project`` is off: e.g. the
         chordae of a valve, whose compressed struts (an input truss carries its law in compression) give the
         tangent a negative lateral stiffness :math:`-N/\ell` per strut that an unprojected step matrix must
         out-shift, shortening every other mode's step with it, while the leaflets keep the soft curvature that
-        projection would drop.
+        projection would drop; or the IPC contact (the valve's settle stage), whose stencils projected one by one
+        keep a coapting patch's sliding directions soft.
     shift_terms : tuple of str
         Names of terms whose indefinite element blocks (for a sparse matrix such as contact's: connected blocks) are
         shifted by the smallest multiple of the identity that makes each semidefinite (:func:`shift_psd`): a local
         Levenberg shift where one term's negative curvature (e.g. a contact pair near a free edge) would otherwise set
-        the global shift that damps every soft mode of the structure.
+        the global shift that damps every soft mode of the structure. For the IPC barrier a shifted patch stiffens
+        its sliding too: on the 1.0 diseased valve's held load, 5.5e-3 after 25 settle steps against 7.8e-8 after
+        34 with the stencils projected (``project_terms``).
     eta : float
         Accept a step when :math:`\rho = \Delta\Pi/m \ge \eta`.
     local_shift, local_decay : float
