@@ -7,7 +7,8 @@ before and after (the machine may be shared), wall time, path and held steps, it
 residual, intersection, smallest corner Jacobian, contact pairs and where the time went, measured by wrapping the
 calls with timers (no profiler): each term's assembly and energy by term type, the tangent's sparse sum, CCD
 (``IPCContact.step_fraction``), the intersection checks and the collision counts of the step records, and the
-analysis, factorisation and solve of :class:`skvalve.fem.solvers.linsolve.LinearSolver`. Target for the 1.0 diseased
+pattern set-up, factorisation (of which PARDISO's reordering, once per new pattern) and solve of
+:class:`skvalve.fem.solvers.linsolve.LinearSolver`. Target for the 1.0 diseased
 valve from the open state: <= 1800 s on 2 cores. Needs the input (``$SKVALVE_TRIVALVE``; Mathur et al. 2022, CC BY-NC-SA
 4.0); exits 2 without it.
 
@@ -45,10 +46,14 @@ class Timers:
     def __init__(self) -> None:
         self.seconds: dict[str, float] = defaultdict(float)
         self.calls: dict[str, int] = defaultdict(int)
+        self.within: dict[str, str] = {}  # a nested label -> the label whose time includes it
 
-    def wrap(self, owner, name: str, label: str) -> None:
-        """Replace ``owner.name`` (an instance's method or a class's function) by a timed call of it."""
+    def wrap(self, owner, name: str, label: str, within: str | None = None) -> None:
+        """Replace ``owner.name`` (an instance's method or a class's function) by a timed call of it; ``within``: the
+        label of the wrapped call that makes this one (its time is a part of that label's, listed under it)."""
         original = getattr(owner, name)
+        if within is not None:
+            self.within[label] = within
 
         def timed(*args, **kwargs):
             start = time.perf_counter()
@@ -62,10 +67,17 @@ class Timers:
 
     def lines(self, wall: float) -> list[str]:
         """One line per label, largest first, and the rest of ``wall`` (controller, line-search arithmetic, output)."""
-        rows = sorted(self.seconds.items(), key=lambda item: -item[1])
-        out = [f"  {label:44s} {seconds:9.1f} s {100 * seconds / wall:5.1f} %  {self.calls[label]:7d} calls"
-               for label, seconds in rows]
-        rest = wall - sum(self.seconds.values())
+        rows = sorted(((label, seconds) for label, seconds in self.seconds.items() if label not in self.within),
+                      key=lambda item: -item[1])
+        out = []
+        for label, seconds in rows:
+            out.append(f"  {label:44s} {seconds:9.1f} s {100 * seconds / wall:5.1f} %  {self.calls[label]:7d} calls")
+            for part, parent in self.within.items():
+                if parent == label and part in self.seconds:
+                    share = self.seconds[part]
+                    out.append(f"    {'of which ' + part:42s} {share:9.1f} s {100 * share / wall:5.1f} %  "
+                               f"{self.calls[part]:7d} calls")
+        rest = wall - sum(seconds for label, seconds in self.seconds.items() if label not in self.within)
         out.append(f"  {'other (controller, vector algebra, output)':44s} {rest:9.1f} s {100 * rest / wall:5.1f} %")
         return out
 
@@ -81,8 +93,9 @@ def instrument(setup, timers: Timers) -> None:
     timers.wrap(setup.contact, "step_fraction", "CCD (IPCContact.step_fraction)")
     timers.wrap(setup.contact, "intersects", "intersection checks (IPCContact.intersects)")
     timers.wrap(setup.contact, "active_pairs", "collision counts (IPCContact.active_pairs)")
-    timers.wrap(LinearSolver, "analyse", "linsolve analysis")
+    timers.wrap(LinearSolver, "analyse", "linsolve pattern (LinearSolver.analyse)")
     timers.wrap(LinearSolver, "factorize", "linsolve factorisation")
+    timers.wrap(LinearSolver, "_reorder_pardiso", "PARDISO reordering (phase 11)", within="linsolve factorisation")
     timers.wrap(LinearSolver, "solve", "linsolve solve")
 
 

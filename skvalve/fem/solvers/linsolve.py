@@ -46,6 +46,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .sparse_patterns import rows_sorted_unique, upper_triangle
+
 __all__ = [
     "LinearSolver", "SolverStatistics", "SolverUnavailableError", "SlowSolverWarning", "solve", "solver_name",
     "available_solvers", "cached_solver", "clear_cache", "solve_if_definite",
@@ -238,30 +240,16 @@ class LinearSolver:
                              f"got {indptr.size} indptr entries and {indices.size} indices")
         if self.matches(indptr, indices):
             return self
+        if not rows_sorted_unique(indptr, indices):
+            raise ValueError("pattern indices must be sorted and unique within each row")
         self._release()
         self._indptr, self._indices, self.n = indptr.copy(), indices.copy(), n
-        rows = np.repeat(np.arange(n), np.diff(indptr))
-        if np.any(np.diff(indices)[np.diff(rows) == 0] <= 0):
-            raise ValueError("pattern indices must be sorted and unique within each row")
-        if self.symmetric:
-            self._upper_triangle(rows, indices)
+        if self.symmetric:  # upper triangle with every diagonal entry present (PARDISO needs them), and its sources
+            self._upper_indptr, self._upper_indices, source = upper_triangle(indptr, indices)
+            self._upper_source = np.maximum(source, 0)
+            self._upper_inserted = source < 0
         self._indptr32, self._indices32 = indptr.astype(np.int32), indices.astype(np.int32)
-        self._rows = rows
         return self
-
-    def _upper_triangle(self, rows: np.ndarray, indices: np.ndarray) -> None:
-        """Upper-triangle pattern with every diagonal entry present (PARDISO needs them) and its sources."""
-        n = self.n
-        upper = np.flatnonzero(indices >= rows)
-        missing = np.setdiff1d(np.arange(n), rows[upper][indices[upper] == rows[upper]])
-        up_rows = np.concatenate([rows[upper], missing])
-        up_cols = np.concatenate([indices[upper], missing])
-        source = np.concatenate([upper, np.full(missing.size, -1)])
-        order = np.lexsort((up_cols, up_rows))
-        self._upper_source = np.maximum(source[order], 0)
-        self._upper_inserted = source[order] < 0
-        self._upper_indptr = np.concatenate([[0], np.cumsum(np.bincount(up_rows, minlength=n))]).astype(np.int32)
-        self._upper_indices = up_cols[order].astype(np.int32)
 
     # ------------------------------------------------------------ factorisation
     def factorize(self, values: np.ndarray | sp.spmatrix) -> LinearSolver:
@@ -299,14 +287,20 @@ class LinearSolver:
             self._data[self._upper_inserted] = 0.0
         else:
             self._data = values
-        # phase 12 = analysis + factorisation (first time), 22 = factorisation with the kept analysis
         try:
-            self._pardiso.call(12 if first else 22, self._data, *self._pardiso_pattern())
+            if first:
+                self._reorder_pardiso()
+            self._pardiso.call(22, self._data, *self._pardiso_pattern())
         except np.linalg.LinAlgError:
             if first:
                 self._release()
             raise
-        self.statistics.analyses += first
+
+    def _reorder_pardiso(self) -> None:
+        """PARDISO's analysis (phase 11: reordering and symbolic factorisation), once per pattern; the values of the
+        first matrix go with it (scaling and matching of a non-symmetric one)."""
+        self._pardiso.call(11, self._data, *self._pardiso_pattern())
+        self.statistics.analyses += 1
 
     def _pardiso_pattern(self) -> tuple[np.ndarray, np.ndarray]:
         if self.symmetric:
