@@ -81,15 +81,47 @@ def test_newton_tries_converge_where_the_energy_model_of_a_follower_load_stalls(
 
 
 def test_a_failed_newton_try_is_rewound():
-    """Tries asked to cut the residual to 1e-14 of itself all fail: the run ends where the plain trust region ends."""
+    """Tries asked to cut the residual to 1e-14 of itself, without backtracking, all fail: the run ends where the plain
+    trust region ends."""
     plain = trust_region(sheared_block(), 1.0, np.zeros(sheared_block().space.n_dofs),
                          TrustRegionOptions(rtol=1e-11, radius=0.1), progress=False)
     tried = trust_region(sheared_block(), 1.0, np.zeros(plain.u.size),
-                         TrustRegionOptions(rtol=1e-11, radius=0.1, newton_below=1.0, newton_decrease=1e-14),
+                         TrustRegionOptions(rtol=1e-11, radius=0.1, newton_below=1.0, newton_decrease=1e-14,
+                                            newton_backtracks=0),
                          progress=False)
     assert tried.converged and tried.newton_tries >= 1 and tried.newton_steps == plain.newton_steps
     assert np.abs(tried.u - plain.u).max() <= 1e-9 * np.abs(plain.u).max()
     assert tried.residuals == pytest.approx(plain.residuals, rel=1e-6)
+
+
+def test_a_newton_try_that_overshoots_backtracks_to_the_fraction_that_lowers_the_residual():
+    """The arch's apex lifted to y = 0.4 under a load of 0.02 (above its limit load: the equilibrium lies below the
+    supports): Newton's full step lowers the residual only to about 0.6 of itself, its half to about 0.66. Without
+    backtracking the try fails (the first step is an energy step); with it the half step is kept (1 - 0.5 x 0.5 =
+    0.75 allowed). Both runs end on the closed-form equilibrium."""
+    problem, law, h, dof = _arch(0.02)
+    start = np.zeros(problem.space.n_dofs)
+    start[dof] = 0.4 - h
+    residual, tangent = problem.assemble(start, 1.0)
+    full = -residual[dof] / problem.tangent_matrix(tangent).toarray()[0, 0]
+
+    def ratio(fraction):
+        trial = start.copy()
+        trial[dof] += fraction * full
+        return abs(problem.assemble(trial, 1.0, tangent=False)[0][dof]) / abs(residual[dof])
+
+    assert ratio(1.0) > 0.5 and ratio(0.5) <= 0.75  # the case this test is about
+    options = TrustRegionOptions(rtol=1e-12, radius=0.05, max_radius=1.0, project=False, newton_below=1e9)
+    first = []
+    result = trust_region(problem, 1.0, start, options, progress=False,
+                          callbacks=[lambda event: first.append(event.u[dof] - start[dof]) if not first else None])
+    assert result.converged and np.isnan(result.ratios[0])  # the first step a kept Newton try ...
+    assert first[0] == pytest.approx(0.5 * full, rel=1e-12)  # ... of half Newton's step
+    root = brentq(lambda yy: _arch_force(law, yy) + 0.02, -2.0, -0.13, xtol=1e-15)  # past the limit load
+    assert h + result.u[dof] == pytest.approx(root, rel=1e-9)
+    plain = trust_region(_arch(0.02)[0], 1.0, start, replace(options, newton_backtracks=0), progress=False)
+    assert plain.converged and not np.isnan(plain.ratios[0])  # without backtracking the first try fails
+    assert h + plain.u[dof] == pytest.approx(root, rel=1e-9)
 
 
 def _arch(load: float):

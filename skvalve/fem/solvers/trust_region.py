@@ -41,8 +41,12 @@ A follower pressure on an open surface (leaflets with free edges) makes the prob
 near the equilibrium the work of its non-symmetric part is as large as the energy decrease the model predicts, and
 :math:`K_s` may stay indefinite at a stable state. Below ``newton_below`` each step first tries Newton's step with
 the full tangent (held to the largest radius, ``max_radius``) and keeps it when the residual norm falls to
-``newton_decrease`` of its value: there the merit is the residual, whose root is the equilibrium whatever the
-symmetry. The residual is always the
+``newton_decrease`` of its value, or else the first of its halves, quarters, ... (``newton_backtracks``) that lowers
+the norm in proportion to its length: there the merit is the residual, whose root is the equilibrium whatever the
+symmetry, and which Newton's direction lowers for any regular tangent. On the 1.0 annuloplasty valve's held load the
+energy steps had circled for 400 steps between relative residuals of 2e-4 and 1e-2 while each released energy; from
+there, tries backtracked to a quarter or a half of Newton's step brought the residual from 6.6e-3 to 1.8e-9 in 13
+steps. The residual is always the
 undamped one: converged means :math:`\lVert R_f\rVert \le
 \max(\text{atol}, \text{rtol}\cdot f_\text{ref})` (the reactions' and loads' scale, as Newton).
 """
@@ -381,9 +385,10 @@ def _stalled(energy_changes: list[float], opts: TrustRegionOptions) -> bool:
 
 
 def _newton_try(problem, solver, K, residual, u, t, step, radius, norm, opts, result, limit):
-    """Newton's step with the full tangent, scaled into ``radius`` (the options' largest): (step, residual, tangent,
-    trapezoidal work, largest nodal motion) when the residual norm falls below ``newton_decrease * norm``, else None
-    (rewound)."""
+    """Newton's step with the full tangent, scaled into ``radius`` (the options' largest), or the first of its
+    fractions a = 1/2, 1/4, ... (``newton_backtracks`` halvings) whose residual norm falls below
+    ``1 - a (1 - newton_decrease)`` of ``norm``: (step, residual, tangent, trapezoidal work, largest nodal motion), or
+    None (rewound) when none does."""
     free, space = problem.pattern.free, problem.space
     clock = time.perf_counter()
     try:
@@ -406,19 +411,24 @@ def _newton_try(problem, solver, K, residual, u, t, step, radius, norm, opts, re
         p *= fraction
         largest *= fraction
     clock = time.perf_counter()
-    try:  # the residual first: the tangent only for a try that is taken
-        trial, _ = problem.assemble(u + p, t, tangent=False, step=step)
-        problem.check_state(u + p, t)
-    except (NonPositiveJacobianError, StateRefused):
-        trial = None
-    if trial is None or not np.all(np.isfinite(trial)) or \
-            np.linalg.norm(trial[free]) > opts.newton_decrease * norm:
-        result.timings["assembly"] += time.perf_counter() - clock
+    fraction = 1.0
+    for _ in range(opts.newton_backtracks + 1):
+        trial_step = fraction * p
+        try:  # the residual first: the tangent only for a try that is taken
+            trial, _ = problem.assemble(u + trial_step, t, tangent=False, step=step)
+            problem.check_state(u + trial_step, t)
+        except (NonPositiveJacobianError, StateRefused):
+            trial = None
+        if trial is not None and np.all(np.isfinite(trial)) and \
+                np.linalg.norm(trial[free]) <= (1.0 - fraction * (1.0 - opts.newton_decrease)) * norm:
+            trial, tangent = problem.assemble(u + trial_step, t, tangent=True, step=step)
+            result.timings["assembly"] += time.perf_counter() - clock
+            work = 0.5 * float((residual[free] + trial[free]) @ trial_step[free])
+            return trial_step, trial, tangent, work, fraction * largest
         problem.rewind()
-        return None
-    trial, tangent = problem.assemble(u + p, t, tangent=True, step=step)
+        fraction *= 0.5
     result.timings["assembly"] += time.perf_counter() - clock
-    return p, trial, tangent, 0.5 * float((residual[free] + trial[free]) @ p[free]), largest
+    return None
 
 
 def _negative_eigenvalues(solver, problem, tangent, result) -> int | None:

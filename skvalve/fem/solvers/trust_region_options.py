@@ -55,11 +55,16 @@ class TrustRegionOptions:
         one (a local Levenberg-Marquardt term :math:`s_i D_i` added to :math:`H + \alpha D`; the equilibrium does not
         depend on it), and the radius is cut only to 0.7 of the step; after each accepted step the local shifts fall
         by ``local_decay`` (below ``min_shift``: zero). ``local_shift`` 0: off (every rejection halves the radius).
-    newton_below, newton_decrease : float
+    newton_below, newton_decrease, newton_backtracks : float, float, int
         Below the relative residual ``newton_below`` (0: never) a step is first tried as Newton's with the full
         tangent, scaled into ``max_radius``, and kept when the residual norm falls below ``newton_decrease`` times its
-        value (module docstring); a failed try is rewound and not repeated until the residual has halved or ten steps
-        have passed.
+        value (module docstring). Where it does not, the try backtracks along the same direction: the fraction
+        :math:`a` = 1/2, 1/4, ... (at most ``newton_backtracks`` halvings) is kept when the norm falls below
+        :math:`1 - a\,(1 - \text{newton\_decrease})` of its value (a sufficient decrease proportional to the
+        fraction). Newton's direction lowers the residual norm for any regular tangent, symmetric or not, so a short
+        enough fraction always does; a follower pressure on an open surface has no potential, and the energy steps can
+        circle its equilibrium (released energy each step, the residual not falling). A failed try is rewound and not
+        repeated until the residual has halved or ten steps have passed.
     fit_radius : int
         A step longer than the radius is shortened by raising the shift :math:`\alpha` (at most this many
         refactorisations, :func:`fitted_shift`) before what is left is scaled down; 0: scaled at once. Scaling keeps
@@ -106,6 +111,7 @@ class TrustRegionOptions:
     local_decay: float = 0.5
     newton_below: float = 0.0
     newton_decrease: float = 0.5
+    newton_backtracks: int = 5
     fit_radius: int = 0
     shift_scaling: str = "diagonal"
     rtol: float = 1e-6
@@ -133,6 +139,9 @@ class TrustRegionOptions:
         if not (math.isfinite(self.newton_below) and self.newton_below >= 0.0) or not 0.0 < self.newton_decrease < 1.0:
             raise ValueError("TrustRegionOptions: need newton_below >= 0 and 0 < newton_decrease < 1; got "
                              f"{self.newton_below!r}, {self.newton_decrease!r}")
+        if not (isinstance(self.newton_backtracks, int) and self.newton_backtracks >= 0):
+            raise ValueError(f"TrustRegionOptions.newton_backtracks must be an integer >= 0; got "
+                             f"{self.newton_backtracks!r}")
         if self.shift_scaling not in ("diagonal", "uniform"):
             raise ValueError(f"TrustRegionOptions.shift_scaling must be 'diagonal' or 'uniform'; got "
                              f"{self.shift_scaling!r}")
