@@ -234,3 +234,28 @@ def test_closed_form_projection_is_the_nearest_psd_bar_tangent():
     assert np.allclose(state.projected, project_psd(state.matrices), atol=1e-12 * np.abs(state.matrices).max())
     taut = (state.axial_force > 0.0) & (np.arange(n) % 4 // 2 == 0)
     assert np.array_equal(state.projected[taut], state.matrices[taut])
+
+
+def test_each_block_groups_positions_keep_their_own_width_and_assemble_the_dense_sum():
+    """The CSR positions of the hexes (24 dofs) and of the chord (6) are built at each block's own width (no
+    padding to the widest block: 3.6 GB of padding on the 1.1 healthy valve), and the assembled free-dof tangent is
+    the dense sum of every element block (np.add.at, no CSR positions)."""
+    solid, chord, face, anchor = two_blocks_with_chord(OgdenUniaxial((2.0,), (3.0,)), 0.1, 1.5)
+    solid.add_dirichlet(lambda X: X[0] == 0.0, 0.0)
+    pattern = solid.pattern
+    for term, positions in zip(solid.terms, pattern.positions, strict=True):
+        for dofs, block in zip(term.connectivity(), positions, strict=True):
+            assert block.shape == (dofs.shape[0], dofs.shape[1], dofs.shape[1])
+            assert getattr(block.base, "nbytes", block.nbytes) <= block.nbytes  # no view into a padded array
+    rng = np.random.default_rng(3)
+    u = np.zeros(solid.space.n_dofs)
+    u[pattern.free] = 0.05 * rng.standard_normal(pattern.free.size)
+    _, tangent = solid.assemble(u, 1.0)
+    dense = np.zeros((solid.space.n_dofs, solid.space.n_dofs))
+    for contribution in tangent.contributions:
+        for block in contribution.blocks:
+            if block.dofs.size:
+                np.add.at(dense, (block.dofs[:, :, None], block.dofs[:, None, :]), block.matrices)
+    K = solid.tangent_matrix(tangent).toarray()
+    expected = dense[np.ix_(pattern.free, pattern.free)]
+    assert np.abs(K - expected).max() <= 1e-12 * np.abs(expected).max()

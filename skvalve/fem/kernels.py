@@ -31,7 +31,8 @@ from numba import njit, prange
 # runtimes when they start (first parallel call), so set at import; an explicit user setting wins.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
-__all__ = ["element_gradients", "element_stiffness", "element_forces", "scatter_add", "csr_pattern", "psd_blocks"]
+__all__ = ["element_gradients", "element_stiffness", "element_forces", "scatter_add", "csr_pattern", "csr_structure",
+           "csr_positions", "psd_blocks"]
 
 
 @njit(parallel=True, cache=True)
@@ -131,11 +132,11 @@ def scatter_add(ke: np.ndarray, positions: np.ndarray, data: np.ndarray) -> None
 
 
 @njit(cache=True)
-def csr_pattern(element_dofs: np.ndarray, n: int):
-    """Sparsity pattern of the assembled matrix and the CSR position of every element entry.
+def csr_structure(element_dofs: np.ndarray, n: int):
+    """Sparsity pattern (``indptr``, sorted ``indices``) of the matrix assembled from element blocks.
 
-    ``element_dofs[e, m]`` are (reduced) dof numbers, negative for dofs left out (constraints).
-    Returns ``indptr``, sorted ``indices`` and ``positions[e, m, k]`` (-1 where left out).
+    ``element_dofs[e, m]`` are (reduced) dof numbers, negative for dofs left out (constraints, or padding of
+    connectivities narrower than the array).
     """
     nel, ndofe = element_dofs.shape
     start = np.zeros(n + 1, dtype=np.int64)
@@ -176,6 +177,14 @@ def csr_pattern(element_dofs: np.ndarray, n: int):
     for r in range(n):
         length = indptr[r + 1] - indptr[r]
         indices[indptr[r]:indptr[r + 1]] = buffer[start[r]:start[r] + length]
+    return indptr, indices
+
+
+@njit(cache=True)
+def csr_positions(element_dofs: np.ndarray, indptr: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """The CSR position ``positions[e, m, k]`` of every element entry in a pattern that holds it (-1 where a dof is
+    left out). Called per group of blocks of one width, so that no block is padded to the widest one's size."""
+    nel, ndofe = element_dofs.shape
     positions = np.full((nel, ndofe, ndofe), -1, dtype=np.int64)
     for e in range(nel):
         for m in range(ndofe):
@@ -194,7 +203,13 @@ def csr_pattern(element_dofs: np.ndarray, n: int):
                     else:
                         hi = mid
                 positions[e, m, k] = lo
-    return indptr, indices, positions
+    return positions
+
+
+def csr_pattern(element_dofs: np.ndarray, n: int):
+    """:func:`csr_structure` and :func:`csr_positions` of one block array: ``indptr``, ``indices``, ``positions``."""
+    indptr, indices = csr_structure(element_dofs, n)
+    return indptr, indices, csr_positions(element_dofs, indptr, indices)
 
 
 @njit(parallel=True, cache=True)

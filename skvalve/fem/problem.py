@@ -19,7 +19,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .errors import SingularSystemError
-from .kernels import csr_pattern, scatter_add
+from .kernels import csr_positions, csr_structure, scatter_add
 from .loads import Dirichlet
 from .space import Space
 from .terms import Contribution, Term
@@ -138,17 +138,17 @@ class Problem:
         for c in flat:
             stacked[row: row + c.shape[0], : c.shape[1]] = reduced[c]
             row += c.shape[0]
-        indptr, indices, positions = csr_pattern(stacked, free.size)
-        per_term, row = [], 0
+        indptr, indices = csr_structure(stacked, free.size)
+        # each block group's positions at its own width: padding every block to the widest (a chord's insertion
+        # patches) took 3.6 GB on the 1.1 healthy valve (129 k dofs)
+        per_term = []
         for group in connectivities:
             blocks = []
             for c in group:
                 if c.size == 0:
                     blocks.append(np.zeros((0, 0, 0), dtype=np.int64))
                     continue
-                m = c.shape[1]
-                blocks.append(np.ascontiguousarray(positions[row: row + c.shape[0], :m, :m]))
-                row += c.shape[0]
+                blocks.append(csr_positions(np.ascontiguousarray(reduced[c]), indptr, indices))
             per_term.append(blocks)
         return Pattern(fixed, free, reduced, indptr.astype(np.int32), indices.astype(np.int32), per_term)
 
