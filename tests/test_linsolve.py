@@ -83,7 +83,7 @@ def test_module_solve_keeps_the_analysis_between_calls():
         K = _same_pattern_new_values(A, 20 + seed, symmetric=True)
         x = linsolve.solve(K, np.ones(400), name, symmetric=True)
         assert np.allclose(K @ x, np.ones(400), rtol=1e-10)
-    stats = linsolve._CACHE.solvers[(name, True)].statistics
+    stats = linsolve.cached_solver(name, symmetric=True).statistics
     assert (stats.analyses, stats.factorizations) == (1, 3)
     linsolve.clear_cache()
     assert not linsolve._CACHE.solvers
@@ -179,3 +179,38 @@ def test_module_solve_keeps_one_solver_per_thread():
     with ThreadPoolExecutor(max_workers=2) as pool:
         residuals = list(pool.map(work, matrices * 2))
     assert max(residuals) < 1e-10
+
+
+@pytest.mark.skipif("pardiso" not in linsolve.available_solvers(), reason="Cholesky through PARDISO")
+def test_a_definite_solver_gives_up_on_an_indefinite_matrix_and_keeps_its_analysis():
+    """``definite=True`` (PARDISO's Cholesky): a positive definite matrix is solved as by the indefinite
+    factorisation; one negative eigenvalue (an eigenvalue of the Laplacian-like matrix shifted below zero) raises
+    NotPositiveDefiniteError, as does a semidefinite one; the analysis is kept across the failures (one in all);
+    solve_if_definite answers None for the indefinite matrix and the solution for the definite one."""
+    A = _laplacian_like(324, 5, symmetric=True).tocsr()  # 18 x 18 grid
+    A.sort_indices()
+    n = A.shape[0]
+    lowest = float(np.linalg.eigvalsh(A.toarray())[0])
+    identity = sp.identity(n, format="csr")
+    definite = linsolve.LinearSolver("pardiso", symmetric=True, definite=True)
+    reference = linsolve.LinearSolver("pardiso", symmetric=True)
+    rhs = np.linspace(1.0, 2.0, n)
+    for matrix in (A, (A - 0.5 * lowest * identity).tocsr()):
+        matrix.sort_indices()
+        definite.analyse(matrix).factorize(matrix)
+        reference.analyse(matrix).factorize(matrix)
+        assert definite.inertia() == (n, 0) == reference.inertia()
+        np.testing.assert_allclose(definite.solve(rhs), reference.solve(rhs), rtol=1e-10)
+    for shift in (1.5 * lowest, lowest):  # one negative eigenvalue; a zero one
+        shifted = (A - shift * identity).tocsr()
+        shifted.sort_indices()
+        definite.analyse(shifted)
+        expected = linsolve.NotPositiveDefiniteError if shift > lowest else np.linalg.LinAlgError
+        with pytest.raises(expected):
+            definite.factorize(shifted)
+        assert linsolve.solve_if_definite(shifted, rhs) is None
+    assert definite.statistics.analyses == 1
+    np.testing.assert_allclose(linsolve.solve_if_definite(A, rhs), reference.analyse(A).factorize(A).solve(rhs),
+                               rtol=1e-10)
+    with pytest.raises(ValueError, match="definite=True needs symmetric=True"):
+        linsolve.LinearSolver("pardiso", definite=True)

@@ -188,8 +188,11 @@ class HoldOptions:
         the relative residual below which the settle stage tries Newton's step with the full tangent (the follower
         pressure's non-symmetric part matters near the equilibrium; quadratic convergence). 1e-2: the penalty closure's
         1e-4 was relative to the reactions, about 200 times the pressure's nodal forces on the 1.0 valve; on the
-        stand-in deck 1e-2 closed the held load in 11 steps (70 iterations in all) against 14 (73) with 1e-4. A failed
-        try costs one factorisation and is repeated only after the residual halved or ten steps.
+        stand-in deck 1e-2 closed the held load in 11 steps (70 iterations in all) against 14 (73) with 1e-4. A try
+        whose full step does not halve the residual backtracks to a fraction that lowers it in proportion
+        (``TrustRegionOptions.newton_backtracks``): the energy steps alone circled the annuloplasty valve's equilibrium
+        for 400 steps (2e-4 to 1e-2), the backtracking tries closed it from there in 13. A failed try costs one
+        factorisation and up to six residuals, and is repeated only after the residual halved or ten steps.
     """
 
     rtol: float = 1e-6

@@ -145,8 +145,10 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
     _, values = problem.constrained(t)
     u[fixed] = values
     result = TrustRegionResult(u=u, load_factor=t)
-    solvers = (linsolve.LinearSolver(solver_name, symmetric=True), linsolve.LinearSolver(solver_name, symmetric=True),
-               linsolve.LinearSolver(solver_name, symmetric=problem.symmetric))  # shifted H, K_s's inertia, K
+    # shifted H and K_s by Cholesky (a matrix that is not definite gives up early), K by LU or LDL^T
+    solvers = (linsolve.LinearSolver(solver_name, symmetric=True, definite=True),
+               linsolve.LinearSolver(solver_name, symmetric=True, definite=True),
+               linsolve.LinearSolver(solver_name, symmetric=problem.symmetric))
     clock = time.perf_counter()
     if relax is not None:
         u, _ = relax(u, t)
@@ -197,7 +199,8 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
         while True:
             if relative <= opts.rtol or norm <= opts.atol:
                 result.converged = True
-                result.negative_eigenvalues = _negative_eigenvalues(solvers[1], problem, tangent, result)
+                result.negative_eigenvalues = _negative_eigenvalues(
+                    linsolve.LinearSolver(solver_name, symmetric=True), problem, tangent, result)
                 break
             if _stalled(state.energy_changes, opts):
                 result.stalled = True

@@ -209,8 +209,11 @@ def shifted_direction(solvers, symmetric_K, K, H, D, rhs, shift: float, fallback
     """
     symmetric, definite, general = solvers
     if shift == 0.0 and newton_allowed:
-        factorize_counted(definite, symmetric_K, result)
-        inertia = definite.inertia()
+        try:
+            factorize_counted(definite, symmetric_K, result)
+            inertia = definite.inertia()
+        except np.linalg.LinAlgError:  # not definite (a Cholesky solver gives up at the first non-positive pivot)
+            inertia = (0, 1)
         if inertia is not None and inertia[1] == 0:
             try:
                 factorize_counted(general, K, result)
