@@ -450,6 +450,9 @@ def solve_if_definite(matrix: sp.spmatrix, rhs: np.ndarray, solver: str | None =
     """``x`` with ``matrix @ x = rhs`` for a symmetric ``matrix`` that is positive definite, ``None`` when its
     Cholesky factorisation (PARDISO's matrix type 2, :class:`LinearSolver` with ``definite=True``) meets a
     non-positive pivot or it is singular: a matrix that is not definite usually costs a fraction of a factorisation.
+    Unlike the symmetric indefinite factorisation used before (whose pivots below 1e-8 of the matrix's size PARDISO
+    perturbed and counted), a matrix singular only to rounding can pass as definite; the callers add a pseudo-mass or
+    a shift, which keeps their matrices clear of that.
     Raises :class:`SolverUnavailableError` with a backend that has no such factorisation (SciPy's SuperLU)."""
     linear = cached_solver(solver, symmetric=True, definite=True)
     if linear.name != "pardiso":
