@@ -148,7 +148,7 @@ class Problem:
                 if c.size == 0:
                     blocks.append(np.zeros((0, 0, 0), dtype=np.int64))
                     continue
-                blocks.append(csr_positions(np.ascontiguousarray(reduced[c]), indptr, indices))
+                blocks.append(csr_positions(reduced[c], indptr, indices))
             per_term.append(blocks)
         return Pattern(fixed, free, reduced, indptr.astype(np.int32), indices.astype(np.int32), per_term)
 

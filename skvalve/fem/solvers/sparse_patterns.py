@@ -35,33 +35,27 @@ def upper_triangle(indptr: np.ndarray, indices: np.ndarray):
     position in ``indices`` of the entry it copies, or -1 for an inserted diagonal.
     """
     n = indptr.size - 1
-    counts = np.zeros(n, dtype=np.int64)
-    for row in range(n):
-        first = indptr[row + 1]
-        for k in range(indptr[row], indptr[row + 1]):
-            if indices[k] >= row:
-                first = k
-                break
-        counts[row] = indptr[row + 1] - first
-        if first == indptr[row + 1] or indices[first] != row:
-            counts[row] += 1
+    first = np.empty(n, dtype=np.int64)  # each row's first entry on or above the diagonal
+    missing = np.empty(n, dtype=np.bool_)  # the row stores no diagonal entry
     upper_indptr = np.zeros(n + 1, dtype=np.int32)
     for row in range(n):
-        upper_indptr[row + 1] = upper_indptr[row] + counts[row]
+        start = indptr[row + 1]
+        for k in range(indptr[row], indptr[row + 1]):
+            if indices[k] >= row:
+                start = k
+                break
+        first[row] = start
+        missing[row] = start == indptr[row + 1] or indices[start] != row
+        upper_indptr[row + 1] = upper_indptr[row] + indptr[row + 1] - start + missing[row]
     upper_indices = np.empty(upper_indptr[n], dtype=np.int32)
     source = np.empty(upper_indptr[n], dtype=np.int64)
     for row in range(n):
         out = upper_indptr[row]
-        first = indptr[row + 1]
-        for k in range(indptr[row], indptr[row + 1]):
-            if indices[k] >= row:
-                first = k
-                break
-        if first == indptr[row + 1] or indices[first] != row:
+        if missing[row]:
             upper_indices[out] = row
             source[out] = -1
             out += 1
-        for k in range(first, indptr[row + 1]):
+        for k in range(first[row], indptr[row + 1]):
             upper_indices[out] = indices[k]
             source[out] = k
             out += 1

@@ -213,7 +213,7 @@ def shifted_direction(solvers, symmetric_K, K, H, D, rhs, shift: float, fallback
             factorize_counted(definite, symmetric_K, result)
             inertia = definite.inertia()
         except np.linalg.LinAlgError:  # not definite (a Cholesky solver gives up at the first non-positive pivot)
-            inertia = (0, 1)
+            inertia = None
         if inertia is not None and inertia[1] == 0:
             try:
                 factorize_counted(general, K, result)
