@@ -211,26 +211,41 @@ def test_the_clip_input_is_accepted_with_its_approximations_noted(clip):
     assert any(n.startswith("clip arms in contact from") for n in model.notes)
 
 
-def test_the_arms_join_the_contact_when_they_start_to_turn(clip):
-    """Contact with each arm starts at 1.5, the start of "Clip close" where its angle starts to change (the leaflets
-    closed in step 1 overlap the parked arms): before, the collision mesh is the leaflets' alone."""
+def test_the_arms_are_in_contact_from_the_start_and_grip_from_when_they_turn(clip):
+    """Contact with the arms from total time 0: the open leaflets clear every arm there (the barrier's start), and the
+    arms' facets face the leaflets (the positive side, to which the input's one-sided rigid surfaces push). The tie
+    (rough, no-separation contact) captures only from 1.5, the start of "Clip close" where the arms start to turn: a
+    leaflet vertex placed on an arm is free at 1.49 and captured at 1.5."""
     abaqus, model = clip
     starts = {w.name: w.start for w in model.steps}
-    assert [o.active_from for o in model.obstacles] == [starts["Clip close"]] * 4
+    assert [o.active_from for o in model.obstacles] == [0.0] * 4
     assert all(arm.angle.at(starts["Clip close"]) == 0.0 != arm.angle.at(model.end_time) for arm in model.arms)
     setup = valve_setup(abaqus, model=model)
     u = np.zeros(setup.problem.space.n_dofs)
-    assert setup.contact.positions(u, 1.49).shape[0] == setup.contact.n_body
-    assert setup.contact.positions(u, 1.5).shape[0] == setup.contact.rest.shape[0]
+    assert setup.contact.positions(u, 0.0).shape[0] == setup.contact.rest.shape[0]  # arms in the collision mesh
+    assert not setup.contact.intersects(u, 0.0)
+    leaflets = setup.problem.space.mesh.p[:, setup.contact.nodes].T
+    for obstacle in model.obstacles:  # the 50 leaflet vertices nearest each arm lie on its facets' positive side
+        corners = obstacle.vertices[obstacle.triangles]
+        centroids = corners.mean(axis=1)
+        normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+        distance, nearest = cKDTree(centroids).query(leaflets)
+        close = np.argsort(distance)[:50]
+        side = np.einsum("ij,ij->i", leaflets[close] - centroids[nearest[close]], normals[nearest[close]])
+        assert np.all(side > 0.0), obstacle.name
     assert not any("rotational boundary" in n or "outside the model" in n for n in model.notes)
-    # the rough, no-separation contact: a tie on the contact surface's vertices to the four arms, empty while the
-    # open leaflets are 3.1 mm or more from every arm
     (tie,) = [term for term in setup.problem.terms if isinstance(term, ObstacleTie)]
     assert tie.obstacles == model.obstacles and np.array_equal(tie.nodes, setup.contact.nodes)
-    for t in (1.49, 1.5):
-        tie.assemble(u, t, True, None)
+    assert tie.capture_from == [starts["Clip close"]] * 4
+    arm = model.obstacles[0]
+    node = int(setup.contact.nodes[0])
+    for t, captured in ((1.49, 0), (1.5, 1)):
+        moved = u.copy()
+        moved[3 * node:3 * node + 3] = arm.at(t)[0] - setup.problem.space.mesh.p[:, node]
+        tie.assemble(moved, t, True, None)
         tie.commit()
-        assert tie.captured.size == 0
+        assert tie.captured.size == captured
+    assert tie.captured.tolist() == [node]
 
 
 # ---------------------------------------------------------------- single-step inputs as before

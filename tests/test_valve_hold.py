@@ -1,7 +1,7 @@
 """The held phase of :func:`skvalve.valve.run.close_valve` on a stand-in setup (a block under a follower pressure with
-IPC contact on its boundary): the trust-region stages reach the static equilibrium that load-stepped Newton finds, a
-descend stage that runs out of steps hands on to the settle stage, and a run stopped inside the held phase and resumed
-from its kept state (with the trust region's controller) repeats the uninterrupted one."""
+IPC contact on its boundary): the descend stage hands on to proximal steps, which reach the static equilibrium that
+load-stepped Newton finds, with the pseudo-step growing after easy steps and halved after a failed one, and a run
+stopped inside the held phase (in either stage) and resumed from its kept state repeats the uninterrupted one."""
 
 from dataclasses import replace
 from types import SimpleNamespace
@@ -43,55 +43,73 @@ def _newton_end_state() -> np.ndarray:
     return solve(_block().problem, steps=4, rtol=1e-10, progress=False).u()
 
 
-# short steps and Newton's tries only near the end, so that the trust region's own steps (and a stage hand-on) occur
+# short path steps with a heavy pseudo-mass: the path ends 4.5e-3 from the static state; descend steps of at most 2e-4
+# cannot cover that in the 10 steps they have (half of 20), so the proximal steps finish
 OPTIONS = CloseOptions(steps=StepOptions(first=0.25, largest=0.25, damping=1.0),
-                       hold=HoldOptions(max_radius=0.05, newton_below=1e-4))
+                       hold=HoldOptions(max_radius=2e-4, max_steps=20, growth=2.0))
 
 
-def test_the_held_stages_reach_the_static_equilibrium():
+def test_the_descend_stage_hands_on_to_proximal_steps_that_reach_the_static_equilibrium():
     report = run_module.close_valve(None, OPTIONS, setup=_block(), progress=False)
     assert report.converged and report.relative_residual <= 1e-6
-    held = [record for record in report.records if record.phase == "hold"]
-    assert held and report.held_steps == len(held) and all(record.iterations >= 1 for record in held)
-    assert all(record.increment <= 0.05 * (1 + 1e-12) for record in held)  # no node moved more than max_radius
+    phases = [record.phase for record in report.records]
+    assert phases == ["path"] * 4 + ["descend"] * 10 + ["proximal"] * (len(phases) - 14)
+    descend = [record for record in report.records if record.phase == "descend"]
+    assert all(record.moved <= 2e-4 * (1 + 1e-12) for record in descend)  # no node moved more than max_radius
+    proximal = [record for record in report.records if record.phase == "proximal"]
+    assert len(proximal) >= 2 and report.held_steps == len(descend) + len(proximal)
+    # the pseudo-step starts at the path's last step length and doubles after each easy step
+    assert proximal[0].increment == pytest.approx(0.25)
+    easy = OPTIONS.steps.easy_iterations
+    for before, after in zip(proximal, proximal[1:], strict=False):
+        assert after.increment == pytest.approx(before.increment * (2.0 if before.iterations <= easy else 1.0))
     newton = _newton_end_state()
     np.testing.assert_allclose(report.u, newton, atol=1e-5 * np.abs(newton).max())
 
 
-def test_a_descend_stage_out_of_steps_hands_on_to_the_settle_stage(monkeypatch):
-    stages = run_module.held_stages
-    used = []
+def test_a_held_phase_out_of_steps_stops_with_its_last_state():
+    with pytest.raises(run_module.ClosureFailed, match="not converged in 8 held steps"):
+        run_module.close_valve(None, replace(OPTIONS, hold=replace(OPTIONS.hold, max_steps=8)), setup=_block(),
+                               progress=False)
 
-    def short_descend(options, load_norm, solver=None):
-        descend, settle = stages(options, load_norm, solver)
-        return [replace(descend, max_steps=2), settle]
 
-    def seen(state):
-        used.append((state.phase, state.held_stage, state.held_steps))
+def test_a_failed_held_step_is_retried_with_half_the_pseudo_step(monkeypatch):
+    """The first proximal step fails once (as a step whose Newton iterations run out would): it is retried from the same
+    state with half the pseudo-step, and the run still converges to Newton's state."""
+    real = run_module._Run.step
+    failures = []
 
-    monkeypatch.setattr(run_module, "held_stages", short_descend)
-    report = run_module.close_valve(None, OPTIONS, setup=_block(), progress=False, callbacks=[seen])
-    assert report.converged and report.relative_residual <= 1e-6
-    held = [entry for entry in used if entry[0] != "path"]  # the path's last step, each held step, the hand-on, the end
-    assert held[:4] == [("hold", 0, 0), ("hold", 0, 1), ("hold", 0, 2), ("hold", 1, 2)]
-    assert held[-1] == ("done", 1, report.held_steps) and report.held_steps > 2
+    def fail_once(self, t_new, inertia_scale, rtol, max_iter):
+        if self.state.phase == "hold" and self.state.held_stage == 1 and not failures:
+            failures.append(inertia_scale)
+            raise run_module.StepFailed("made to fail")
+        return real(self, t_new, inertia_scale, rtol, max_iter)
+
+    monkeypatch.setattr(run_module._Run, "step", fail_once)
+    report = run_module.close_valve(None, OPTIONS, setup=_block(), progress=False)
+    held = [record for record in report.records if record.phase == "proximal"]
+    assert failures and report.failed_steps == 1 and held[0].increment == pytest.approx(0.125)
+    assert failures[0] == pytest.approx(OPTIONS.steps.damping / 0.25)  # the failed try had the path's last length
+    assert report.converged
     np.testing.assert_allclose(report.u, _newton_end_state(), atol=1e-5 * np.abs(report.u).max())
 
 
-def test_a_run_stopped_in_the_held_phase_resumes_to_the_uninterrupted_result(tmp_path, monkeypatch):
+@pytest.mark.parametrize("stop_at", [2, 12])  # inside the descend stage (with its controller), inside the proximal
+def test_a_run_stopped_in_the_held_phase_resumes_to_the_uninterrupted_result(tmp_path, monkeypatch, stop_at):
     monkeypatch.setattr(run_module, "_write_final", lambda *args: None)  # the stand-in has no chordae to draw
     whole = run_module.close_valve(None, OPTIONS, setup=_block(), progress=False)
-    assert whole.held_steps >= 3
+    assert whole.held_steps > 12
 
     def stop_in_the_hold(state) -> None:
-        if state.held_steps >= 2:
+        if state.held_steps >= stop_at:
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
         run_module.close_valve(None, OPTIONS, setup=_block(), out=tmp_path, progress=False,
                                callbacks=[stop_in_the_hold])
     kept = read_state(tmp_path / "state.npz")
-    assert kept.phase == "hold" and kept.held_steps == 2 and kept.control is not None and kept.control.steps == 2
+    assert kept.phase == "hold" and kept.held_steps == stop_at
+    assert (kept.held_stage, kept.control is not None) == ((0, True) if stop_at < 10 else (1, False))
     resumed = run_module.close_valve(None, out=tmp_path, resume=True, setup=_block(), progress=False)
     assert resumed.converged and resumed.held_steps == whole.held_steps and resumed.iterations == whole.iterations
     np.testing.assert_allclose(resumed.u, whole.u, rtol=0.0, atol=1e-10 * np.abs(whole.u).max())

@@ -31,6 +31,7 @@ def test_options_round_trip_through_json():
     (lambda: StepOptions(max_iter=0), "max_iter"),
     (lambda: StepOptions(growth=0.5), "growth"),
     (lambda: HoldOptions(max_steps=-1), "max_steps"),
+    (lambda: HoldOptions(growth=0.5), "growth"),
     (lambda: ModelOptions(insertion="glue"), "insertion"),
     (lambda: ModelOptions(corner_threshold=1.0), "corner_threshold"),
     (lambda: ModelOptions(corner_threshold=-0.1), "corner_threshold"),

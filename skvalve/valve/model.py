@@ -383,14 +383,15 @@ def valve_model(abaqus: AbaqusModel, layers: int = 4, step: int | None = None, l
         notes.append(f"clip arm {arm.name}: {arm.triangles.shape[0]} triangles turning about reference node "
                      f"{int(abaqus.node_labels[arm.reference_node])}, axis {np.round(arm.axis, 6).tolist()}, by "
                      f"{end:.6g} rad ({np.degrees(end):.4g} deg) at the end")
-    # contact with an arm starts when it starts to turn (the clip repair: the start of "Clip close", 1.5), not
-    # with the input's contact pairs ("Clip capture", 1.0): the leaflets closed by step 1 overlap three of the four
-    # parked arms (a state the barrier cannot start from); the capture step's released pressure reopens them first
-    obstacles = [arm.obstacle(arm.turns_from(windows)) for arm in arms]
+    # the arms are in contact from the start: the leaflets keep the side of each arm they start on, its positive normal
+    # side (the R3D4 facets' orientation), to which the input's one-sided rigid surfaces push overclosed nodes; the
+    # input's arm contact pairs start with "Clip capture", when the leaflets closed by step 1 overlap three of the four
+    # parked arms, a state the barrier cannot start from
+    obstacles = [arm.obstacle(0.0) for arm in arms]
     if arms:
-        starts = ", ".join(f"{arm.name} {o.active_from:g}" for arm, o in zip(arms, obstacles, strict=True))
-        notes.append(f"clip arms in contact from the total time each starts to turn ({starts}); the input's contact "
-                     "pairs start a step earlier, while the leaflets closed in step 1 overlap the parked arms")
+        notes.append("clip arms in contact from the start (the input's contact pairs start with its second step, when "
+                     "the leaflets closed in step 1 overlap the parked arms): the leaflets stay on each arm's positive "
+                     "side, where they start")
     references = {arm.reference_node for arm in arms}
     end_time = windows[-1].end
     ramp = windows[0].period if len(windows) == 1 and windows[0].static else None

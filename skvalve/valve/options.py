@@ -158,56 +158,62 @@ class StepOptions:
 
 @dataclass(frozen=True)
 class HoldOptions:
-    r"""The held load at the end time: the energy trust region
-    (:func:`~skvalve.fem.solvers.trust_region.trust_region`), every accepted step a kept state, the chordae branch
-    points brought to equilibrium after each (block relaxation), in two stages (:func:`~skvalve.valve.run.held_stages`):
+    r"""The held load at the end time (:func:`skvalve.valve.run.close_valve`), in two stages, every accepted step a kept
+    state:
 
-    1. *descend*: steps on the element-projected tangent under Marquardt's diagonal shift, up to ``max_radius`` on any
-       node, until their energy drop stalls (the last 20 steps' average below ``stall_fraction`` of the stage's);
-    2. *settle*: the symmetric tangent itself, with a uniform (Levenberg) shift fitted to the radius and the
-       contact's stencils projected one by one (IPC's own projection: the sliding directions of a contact patch stay
-       soft), and below ``newton_below`` Newton's step with the full tangent, to ``rtol``.
+    1. *descend*: energy trust-region steps (:func:`~skvalve.fem.solvers.trust_region.trust_region`) on the
+       element-projected tangent under Marquardt's diagonal shift, up to ``max_radius`` on any node, the chordae branch
+       points relaxed after each, until their energy drop stalls (the last 20 steps' average below ``stall_fraction``
+       of the stage's). One factorisation a step: it carries the leaflets the millimetres the path's damping left.
+    2. *proximal*: the path's steps with the load held, each a proximal step with the pseudo-mass :math:`c/h`
+       (``StepOptions.damping`` over a pseudo-step :math:`h`) starting at the path's last step length and growing
+       ``growth``-fold after each step of at most ``StepOptions.easy_iterations`` iterations (halved after a failed
+       one), each solved to a tenth of the static residual it starts from, to ``rtol`` of the undamped problem.
 
-    Why not the path's damped steps held at the end load (the method before): their pseudo-mass caps a leaflet's speed
-    at about :math:`p/(c h)` (15 mm per unit step time on the 1.0 valve), and on the 1.0 diseased valve's held load,
-    where leaflet regions had still 7-11 mm to go, 13 held steps (40 minutes) lowered the static residual only from
-    0.246 to 0.207 of the pressure's nodal forces. A trust region bounds each step's motion in millimetres instead, and
-    accepts it by the energy it releases: from the same state the descend stage took 1 mm steps, and the two stages
-    converged the held load to 6.2e-10 (345 held steps, without contact exclusion: docs/mathur2022.md).
+    Why not energy steps to the end (the *settle* stage of the version before): a follower pressure on the leaflets'
+    open surface has no potential, and energy steps circled the equilibrium (the 1.0 annuloplasty valve's held load:
+    400 steps between relative residuals 7e-4 and 1.8e-2, 5136 s, not converged). A proximal step's fixed points are
+    exactly the static equilibria, and its pseudo-mass keeps each step's problem well posed while :math:`h` is short;
+    as :math:`h` grows the steps become Newton's. From the last of those 400 states four proximal steps converged it
+    (61 s: 1.1e-3, 8.5e-5, 6.0e-6, 1.1e-6, 7.9e-8; pseudo-step 1 to 27). Why a descend stage first: from the path's end
+    (0.27) proximal steps took 15-16 Newton iterations to move the annuloplasty valve 0.7-1.2 mm (65-80 s a step, the
+    residual 0.27 -> 0.23 in three), and the earlier fixed pseudo-step (no growth) lowered the diseased valve's from
+    only 0.246 to 0.207 in 13 steps.
 
     rtol
         the undamped, static residual asked for (relative to the end load's nodal pressure forces).
     max_steps
-        accepted steps per stage before the run stops with its last state (the descend stage hands on to the settle
-        stage instead); 0: no held phase (the path only).
+        accepted held steps in all before the run stops with its last state (the descend stage hands on after at most
+        half of them); 0: no held phase (the path only).
     max_radius
-        the most any node moves in one step (mm; the first radius is a quarter of it).
+        the most any node moves in one descend step (mm; the first radius is a quarter of it).
     stall_fraction
         when the descend stage hands on (above).
-    newton_below
-        the relative residual below which the settle stage tries Newton's step with the full tangent (the follower
-        pressure's non-symmetric part matters near the equilibrium; quadratic convergence). 1e-2: the penalty closure's
-        1e-4 was relative to the reactions, about 200 times the pressure's nodal forces on the 1.0 valve; on the
-        stand-in deck 1e-2 closed the held load in 11 steps (70 iterations in all) against 14 (73) with 1e-4. A try
-        whose full step does not halve the residual backtracks to a fraction that lowers it in proportion
-        (``TrustRegionOptions.newton_backtracks``): the energy steps alone circled the annuloplasty valve's equilibrium
-        for 400 steps (2e-4 to 1e-2), the backtracking tries closed it from there in 13. A failed try costs one
-        factorisation and up to six residuals, and is repeated only after the residual halved or ten steps.
+    growth
+        the proximal pseudo-step's factor after an easy step. 3: the damping falls a decade in about two steps, so a
+        state near the equilibrium is reached by Newton's steps within a few, while a failed step costs one halving.
     """
 
     rtol: float = 1e-6
     max_steps: int = 400
     max_radius: float = 1.0
     stall_fraction: float = 0.2
-    newton_below: float = 1e-2
+    growth: float = 3.0
 
     def __post_init__(self) -> None:
-        for name in ("rtol", "max_radius", "newton_below"):
+        for name in ("rtol", "max_radius"):
             _positive("HoldOptions", name, getattr(self, name))
         if not 0.0 <= self.stall_fraction < 1.0:
             raise ValueError(f"HoldOptions.stall_fraction must lie in [0, 1); got {self.stall_fraction!r}")
+        if not isinstance(self.growth, int | float) or not math.isfinite(self.growth) or not self.growth >= 1.0:
+            raise ValueError(f"HoldOptions.growth must be a finite number >= 1; got {self.growth!r}")
         if not isinstance(self.max_steps, int) or isinstance(self.max_steps, bool) or self.max_steps < 0:
             raise ValueError(f"HoldOptions.max_steps must be an integer >= 0; got {self.max_steps!r}")
+
+
+#: fields of :class:`HoldOptions` in kept states of earlier versions (the settle stage's), dropped on reading
+RETIRED_HOLD_FIELDS = ("newton_below",)
+
 
 
 @dataclass(frozen=True)
@@ -236,4 +242,5 @@ class CloseOptions:
         if contact.get("friction") is not None:
             contact["friction"] = Friction(**contact["friction"])
         return cls(ModelOptions(**data["model"]), ContactOptions(**contact), StepOptions(**data["steps"]),
-                   HoldOptions(**data["hold"]), data.get("end"), data.get("solver"))
+                   HoldOptions(**{key: value for key, value in data["hold"].items()
+                                  if key not in RETIRED_HOLD_FIELDS}), data.get("end"), data.get("solver"))

@@ -13,11 +13,14 @@ grows after easy steps and halves after failed ones. The line search's merit is 
 follower pressure's work along the ray, by the trapezoidal rule (the pressure on the leaflets' open surface has no
 potential). The chordae branch points are swept to their own balance (with the step's pseudo-mass) on the first
 iterate and after every accepted iteration (:func:`hub_relaxation`): when the papillary tips move, the cables' pull on
-them is most of the residual. Held load (:class:`~skvalve.valve.options.HoldOptions`, :func:`held_stages`): the
-energy trust region (:func:`~skvalve.fem.solvers.trust_region.trust_region`) at the end time, a *descend* stage of
-projected steps of up to a millimetre until their energy drop stalls, then a *settle* stage on the symmetric tangent
-with Newton's steps at the end, to ``rtol`` (1e-6) of the undamped problem; the chordae branch points are relaxed
-after every step.
+them is most of the residual. Held load (:class:`~skvalve.valve.options.HoldOptions`): the same steps with the load
+held at the end time, each a proximal step :math:`\min_u \Pi(u) + \tfrac{c}{2h}\sum_i V_i|u_i - u_i^k|^2` whose
+pseudo-step :math:`h` starts at the path's last step length and grows ``HoldOptions.growth``-fold after every easy
+step (halved after a failed one), until the static residual is below ``rtol`` (1e-6) of the end load's nodal forces.
+A proximal step cannot circle: its fixed points are exactly the static equilibria, and the pseudo-mass makes each
+step's problem well posed while the pseudo-step is short, so Newton's iterations converge where the undamped
+problem's energy model (the follower pressure on an open surface has no potential) would circle; as :math:`h` grows
+the steps become Newton's steps on the undamped problem.
 
 Output in ``out``: ``state.npz`` after every accepted step (atomic, :mod:`skvalve.valve.state`; ``resume=True``
 continues from it and repeats the uninterrupted run), ``closure.log`` (one line per step), and at the end
@@ -36,7 +39,6 @@ from typing import NamedTuple
 import numpy as np
 from tqdm.auto import tqdm
 
-from ..fem.contact import IPCContact
 from ..fem.elements.fbar import FBarTerm
 from ..fem.elements.truss import Truss
 from ..fem.errors import ConvergenceError, NonPositiveJacobianError, SingularSystemError, SolverError, StateRefused
@@ -53,7 +55,7 @@ from .outputs import ClosureWriter
 from .setup import ValveSetup, smallest_corner_jacobian, valve_setup
 from .state import KeptState, read_state, write_state
 
-__all__ = ["ClosureFailed", "CloseReport", "StepRecord", "close_valve", "held_stages", "hub_relaxation",
+__all__ = ["ClosureFailed", "CloseReport", "StepRecord", "close_valve", "descend_stage", "hub_relaxation",
            "relative_residual"]
 
 logger = logging.getLogger("skvalve.valve")
@@ -68,8 +70,9 @@ class ClosureFailed(SolverError):
 
 @dataclass
 class StepRecord:
-    """One accepted step: phase, step time, step length (path) or largest nodal motion (hold, mm), iterations (held:
-    the trust region's tries, rejected ones included), static relative residual, contact pairs, seconds."""
+    """One accepted step: phase (``path``, or the held load's ``descend`` and ``proximal`` stages), step time, step
+    length (path), trust radius (descend) or pseudo-step (proximal), iterations (descend: the trust region's tries,
+    rejected ones included), static relative residual, contact pairs, seconds, and the largest nodal motion (mm)."""
 
     phase: str
     t: float
@@ -78,14 +81,13 @@ class StepRecord:
     relative_residual: float
     contact_pairs: int
     seconds: float
-    energy_change: float | None = None  # held steps: the energy the step released (N mm, negative)
+    moved: float = float("nan")
 
     def line(self) -> str:
-        size = "dt" if self.phase == "path" else "max_du"
-        energy = "" if self.energy_change is None else f" energy_change={self.energy_change:.3e}"
+        size = {"path": "dt", "descend": "radius"}.get(self.phase, "h")
         return (f"{self.phase} t={self.t:.6g} {size}={self.increment:.3g} iterations={self.iterations} "
-                f"relative_residual={self.relative_residual:.3e} contact_pairs={self.contact_pairs}{energy} "
-                f"seconds={self.seconds:.2f}")
+                f"relative_residual={self.relative_residual:.3e} contact_pairs={self.contact_pairs} "
+                f"max_du={self.moved:.3g} seconds={self.seconds:.2f}")
 
 
 @dataclass
@@ -228,6 +230,7 @@ class _Run:
                 continue
             u, residual, history = outcome
             step_length = t_new - s.t
+            moved = float(np.max(np.abs(u - s.u))) if u.size else 0.0
             relative = self.accept(u, t_new, residual, history)
             s.steps += 1
             grow = len(history) <= opts.easy_iterations
@@ -237,20 +240,27 @@ class _Run:
                 s.phase, s.increment = "hold", step_length
             pairs = self.setup.contact.active_pairs(u, t_new)
             self.keep(StepRecord("path", t_new, step_length, len(history), relative, pairs,
-                                 time.perf_counter() - clock))
+                                 time.perf_counter() - clock, moved))
             bar.update(step_length)
             bar.set_postfix(it=len(history), res=f"{relative:.1e}", pairs=pairs, dt=f"{step_length:.2g}")
 
     def hold(self, bar) -> None:
-        opts, s = self.options.hold, self.state
-        if opts.max_steps == 0:  # the path only (e.g. a run that stops part-way along the load path)
+        """The held load (module docstring): the descend stage, then proximal steps to ``hold.rtol``."""
+        hold, s = self.options.hold, self.state
+        if hold.max_steps == 0:  # the path only (e.g. a run that stops part-way along the load path)
             return
         if not any(float(np.max(np.abs(load.at(self.end)))) > 0.0 for load in self.setup.model.pressures):
             # before the pressure: leaflets hanging from chordae and annulus have no unique static state to hold
             logger.warning("%s: no pressure at step time %.6g: the path only, no held load", s.input, self.end)
             return
-        stages = held_stages(opts, self.setup.load_norm, self.options.solver)
-        hubs = hub_relaxation(self.setup)
+        if s.phase == "hold" and s.held_stage == 0:
+            self.descend(bar)
+        while s.phase == "hold":
+            self.proximal_step(bar)
+
+    def descend(self, bar) -> None:
+        """The descend stage: energy trust-region steps of at most ``max_radius`` until their energy drop stalls."""
+        s = self.state
         clock = [time.perf_counter()]
 
         def keep_step(event: TrustRegionStep) -> None:
@@ -259,48 +269,68 @@ class _Run:
             s.held_steps += 1
             s.iterations += attempts
             pairs = self.setup.contact.active_pairs(event.u, self.end)
-            self.keep(StepRecord("hold", self.end, event.largest, attempts, s.relative_residual, pairs,
-                                 time.perf_counter() - clock[0], event.energy_change))
+            self.keep(StepRecord("descend", self.end, event.control.radius, attempts, s.relative_residual, pairs,
+                                 time.perf_counter() - clock[0], event.largest))
             clock[0] = time.perf_counter()
-            bar.set_postfix(stage=s.held_stage + 1, held=s.held_steps, res=f"{s.relative_residual:.1e}", pairs=pairs)
+            bar.set_postfix(stage=1, held=s.held_steps, res=f"{s.relative_residual:.1e}", pairs=pairs)
 
-        while s.phase == "hold":
-            last = s.held_stage == len(stages) - 1
-            try:
-                result = trust_region(self.problem, self.end, s.u, stages[s.held_stage], callbacks=[keep_step],
-                                      progress=False, relax=hubs, control=s.control)
-            except ConvergenceError as err:
-                if last:
-                    raise ClosureFailed(f"{s.input}: held load not converged ({err}; the kept state is the last "
-                                        "accepted step)") from err
-                result = None
-            s.u = s.u if result is None else result.u
-            if result is not None and result.converged:
-                s.phase = "done"
-                residual, _ = self.problem.assemble(s.u, self.end, tangent=False)
-                s.relative_residual = relative_residual(self.setup, residual)
-            elif not last:  # the descend stage stalled or used its steps: the settle stage from its last state
-                s.held_stage, s.control = s.held_stage + 1, None
-                logger.info("%s: held stage %d from relative residual %.3e", s.input, s.held_stage + 1,
-                            s.relative_residual)
-            else:
-                raise ClosureFailed(f"{s.input}: the held load's last stage stalled at relative residual "
-                                    f"{s.relative_residual:.3e}")
+        try:
+            result = trust_region(self.problem, self.end, s.u, descend_stage(self.options.hold, self.setup.load_norm,
+                                                                             self.options.solver),
+                                  callbacks=[keep_step], progress=False, relax=hub_relaxation(self.setup),
+                                  control=s.control)
+        except ConvergenceError as err:  # out of steps or no step found: the proximal steps go on from the last one
+            logger.info("%s: the descend stage stopped (%s)", s.input, err)
+            result = None
+        if result is not None:
+            s.u = result.u
+        residual, _ = self.problem.assemble(s.u, self.end, tangent=False)
+        s.relative_residual = relative_residual(self.setup, residual)
+        s.held_stage, s.control = 1, None
+        if result is not None and result.converged:
+            s.phase = "done"
+        logger.info("%s: proximal steps from relative residual %.3e", s.input, s.relative_residual)
+        self.keep(None)
+
+    def proximal_step(self, bar) -> None:
+        """One held proximal step (its pseudo-step grown after an easy step, halved after a failed one), or the end."""
+        hold, opts, s = self.options.hold, self.options.steps, self.state
+        if s.relative_residual <= hold.rtol:
+            s.phase = "done"
             self.keep(None)
+            return
+        if s.held_steps >= hold.max_steps:
+            raise ClosureFailed(f"{s.input}: held load not converged in {hold.max_steps} held steps (relative "
+                                f"residual {s.relative_residual:.3e}; the kept state is the last accepted step)")
+        clock = time.perf_counter()
+        h = s.increment
+        # the step's own tolerance: a tenth of the static residual it starts from, down to half the goal
+        rtol = max(0.5 * hold.rtol, 0.1 * s.relative_residual)
+        outcome = self.attempt(self.end, opts.damping / h, rtol, opts.max_iter)
+        if outcome is None:
+            s.increment = 0.5 * h
+            if s.increment < opts.smallest:
+                raise ClosureFailed(f"{s.input}: held step {s.held_steps + 1} failed at every pseudo-step down to "
+                                    f"{opts.smallest:g}: {self.last_error}")
+            return
+        u, residual, history = outcome
+        moved = float(np.max(np.abs(u - s.u))) if u.size else 0.0
+        relative = self.accept(u, self.end, residual, history)
+        s.held_steps += 1
+        s.increment = h * hold.growth if len(history) <= opts.easy_iterations else h
+        pairs = self.setup.contact.active_pairs(u, self.end)
+        self.keep(StepRecord("proximal", self.end, h, len(history), relative, pairs, time.perf_counter() - clock,
+                             moved))
+        bar.set_postfix(stage=2, held=s.held_steps, it=len(history), res=f"{relative:.1e}", pairs=pairs, h=f"{h:.2g}")
 
 
-def held_stages(options: HoldOptions, load_norm: float, solver: str | None = None) -> list[TrustRegionOptions]:
-    """The held load's two trust-region stages (:class:`~skvalve.valve.options.HoldOptions`): *descend* (projected
-    step matrix, Marquardt's diagonal shift, steps scaled into the radius, until the energy drop stalls) and *settle*
-    (the symmetric tangent, a uniform shift fitted to the radius, the IPC contact's stencils projected one by one,
-    Newton's full-tangent steps below ``newton_below``); residuals relative to the end load's nodal forces."""
-    common = {"radius": 0.25 * options.max_radius, "max_radius": options.max_radius, "rtol": options.rtol,
-              "reference": load_norm, "max_steps": options.max_steps, "max_strain_increment": None,
-              "newton_below": options.newton_below, "solver": solver}
-    descend = TrustRegionOptions(project=True, stall_fraction=options.stall_fraction, **common)
-    settle = TrustRegionOptions(project=False, fit_radius=3, shift_scaling="uniform", project_terms=(IPCContact.name,),
-                                **common)
-    return [descend, settle]
+def descend_stage(options: HoldOptions, load_norm: float, solver: str | None = None) -> TrustRegionOptions:
+    """The held load's descend stage (:class:`~skvalve.valve.options.HoldOptions`): trust-region steps on the
+    element-projected tangent with Marquardt's diagonal shift, scaled into a radius of at most ``max_radius``, until the
+    energy drop stalls; residuals relative to the end load's nodal forces."""
+    return TrustRegionOptions(project=True, stall_fraction=options.stall_fraction, radius=0.25 * options.max_radius,
+                              max_radius=options.max_radius, rtol=options.rtol, reference=load_norm,
+                              max_steps=max(1, options.max_steps // 2), max_strain_increment=None, solver=solver)
 
 
 def hub_relaxation(setup: ValveSetup, tol: float = 1e-9) -> BlockRelaxation | None:

@@ -62,9 +62,11 @@ class ObstacleTie(Term):
     space : the body's space.
     nodes : body node numbers that may be captured (e.g. the contact surface's).
     areas : their area weights :math:`A_v` (same length).
-    obstacles : the moving surfaces; each captures only from its ``active_from`` on.
+    obstacles : the moving surfaces.
     capture : the distance (length) within which a vertex is captured.
     stiffness : :math:`k` (force per area and length).
+    capture_from : load factor from which each obstacle captures (default: its ``active_from``); a surface may be in
+        contact before it grips (a clip arm that the leaflets press against before it closes).
     """
 
     name = "obstacle tie"
@@ -77,7 +79,7 @@ class ObstacleTie(Term):
         return self.vertex.size > 0
 
     def __init__(self, space: Space, nodes: np.ndarray, areas: np.ndarray, obstacles: Sequence[Obstacle],
-                 capture: float, stiffness: float) -> None:
+                 capture: float, stiffness: float, capture_from: Sequence[float] | None = None) -> None:
         self.space = space
         self.nodes = np.asarray(nodes, dtype=np.int64).ravel()
         self.areas = np.asarray(areas, dtype=float).ravel()
@@ -89,6 +91,11 @@ class ObstacleTie(Term):
                              f"{stiffness!r}")
         self.obstacles = list(obstacles)
         self.capture, self.stiffness = float(capture), float(stiffness)
+        starts = [o.active_from for o in self.obstacles] if capture_from is None else list(capture_from)
+        if len(starts) != len(self.obstacles) or not all(np.isfinite(start) for start in starts):
+            raise ValueError(f"obstacle tie: capture_from needs one finite load factor per obstacle "
+                             f"({len(self.obstacles)}); got {capture_from!r}")
+        self.capture_from = [max(float(start), o.active_from) for start, o in zip(starts, self.obstacles, strict=True)]
         # the longest triangle edge of each obstacle: a vertex within capture of a triangle is within capture + edge
         # of one of its corners
         self._reach = [capture + float(np.max(np.linalg.norm(o.vertices[o.triangles]
@@ -172,7 +179,7 @@ class ObstacleTie(Term):
         coordinates of each."""
         obstacle = self.obstacles[k]
         empty = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros((0, 3)))
-        if t < obstacle.active_from or free.size == 0:
+        if t < self.capture_from[k] or free.size == 0:
             return empty
         y = obstacle.at(t)
         x = self._positions(u, free)
