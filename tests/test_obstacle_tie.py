@@ -98,3 +98,23 @@ def test_bad_parameters_are_refused():
         ObstacleTie(solid.space, np.arange(8), np.zeros(8), [_turning_plate()], 0.1, 1.0)
     with pytest.raises(ValueError, match="capture and stiffness"):
         ObstacleTie(solid.space, np.arange(8), np.ones(8), [_turning_plate()], 0.0, 1.0)
+    with pytest.raises(ValueError, match="capture_from needs one finite load factor per obstacle"):
+        ObstacleTie(solid.space, np.arange(8), np.ones(8), [_turning_plate()], 0.1, 1.0, capture_from=[0.0, 1.0])
+
+
+def test_an_obstacle_in_contact_grips_only_from_capture_from():
+    """A plate active from 0 that grips from 0.5: the cube's bottom face, 0.01 above the risen plate at 0.4 (within
+    the capture distance 0.1, so an obstacle gripping from its activation would take it), is free there and captured
+    at 0.5."""
+    mesh = skfem.MeshHex()
+    solid = Solid(mesh, NeoHookean(1.0, 10.0))
+    nodes = np.arange(mesh.p.shape[1])
+    tie = ObstacleTie(solid.space, nodes, np.full(nodes.size, 0.25), [_turning_plate()], capture=0.1,
+                      stiffness=100.0, capture_from=[0.5])
+    u = np.zeros(solid.space.n_dofs)
+    tie.assemble(u, 0.4, True, None)
+    tie.commit()
+    assert tie.captured.size == 0
+    tie.assemble(u, 0.5, True, None)
+    tie.commit()
+    assert sorted(tie.captured.tolist()) == sorted(np.flatnonzero(mesh.p[2] == 0.0).tolist())
