@@ -1,7 +1,8 @@
 """The held phase of :func:`skvalve.valve.run.close_valve` on a stand-in setup (a block under a follower pressure with
-IPC contact on its boundary): the descend stage hands on to proximal steps, which reach the static equilibrium that
-load-stepped Newton finds, with the pseudo-step growing after easy steps and halved after a failed one, and a run
-stopped inside the held phase (in either stage) and resumed from its kept state repeats the uninterrupted one."""
+IPC contact on its boundary): the descend and settle stages hand on in turn to proximal steps, which reach the static
+equilibrium that load-stepped Newton finds, with the pseudo-step growing after easy steps and halved after a failed
+one, and a run stopped inside the held phase (in any stage) and resumed from its kept state repeats the uninterrupted
+one."""
 
 from dataclasses import replace
 from types import SimpleNamespace
@@ -43,33 +44,47 @@ def _newton_end_state() -> np.ndarray:
     return solve(_block().problem, steps=4, rtol=1e-10, progress=False).u()
 
 
-# short path steps with a heavy pseudo-mass: the path ends 4.5e-3 from the static state; descend steps of at most 2e-4
-# cannot cover that in the 10 steps they have (half of 20), so the proximal steps finish
+# short path steps with a heavy pseudo-mass: the path ends at a relative residual of 0.12, 4.5e-3 from the static state;
+# energy steps of at most 2e-4 hand on to the proximal steps below 0.08
 OPTIONS = CloseOptions(steps=StepOptions(first=0.25, largest=0.25, damping=1.0),
-                       hold=HoldOptions(max_radius=2e-4, max_steps=20, growth=2.0))
+                       hold=HoldOptions(max_radius=2e-4, proximal_below=0.08, max_steps=40, growth=2.0))
 
 
-def test_the_descend_stage_hands_on_to_proximal_steps_that_reach_the_static_equilibrium():
+@pytest.fixture
+def short_descend(monkeypatch):
+    """A descend stage of three steps, so that the settle stage has steps to take before the hand-on."""
+    stages = run_module.energy_stages
+
+    def three_steps(options, load_norm, solver=None):
+        descend, settle = stages(options, load_norm, solver)
+        return [replace(descend, max_steps=3), settle]
+
+    monkeypatch.setattr(run_module, "energy_stages", three_steps)
+
+
+def test_the_held_stages_hand_on_in_turn_and_reach_the_static_equilibrium(short_descend):
     report = run_module.close_valve(None, OPTIONS, setup=_block(), progress=False)
     assert report.converged and report.relative_residual <= 1e-6
     phases = [record.phase for record in report.records]
-    assert phases == ["path"] * 4 + ["descend"] * 10 + ["proximal"] * (len(phases) - 14)
-    descend = [record for record in report.records if record.phase == "descend"]
-    assert all(record.moved <= 2e-4 * (1 + 1e-12) for record in descend)  # no node moved more than max_radius
-    proximal = [record for record in report.records if record.phase == "proximal"]
-    assert len(proximal) >= 2 and report.held_steps == len(descend) + len(proximal)
+    settle, proximal = phases.count("settle"), phases.count("proximal")
+    assert settle >= 1 and proximal >= 2
+    assert phases == ["path"] * 4 + ["descend"] * 3 + ["settle"] * settle + ["proximal"] * proximal
+    energy = [record for record in report.records if record.phase in ("descend", "settle")]
+    assert all(record.moved <= 2e-4 * (1 + 1e-12) for record in energy)  # no node moved more than max_radius
+    assert energy[-1].relative_residual < 0.08 < energy[-2].relative_residual  # handed on below proximal_below
+    steps = [record for record in report.records if record.phase == "proximal"]
     # the pseudo-step starts at the path's last step length and doubles after each easy step
-    assert proximal[0].increment == pytest.approx(0.25)
+    assert steps[0].increment == pytest.approx(0.25)
     easy = OPTIONS.steps.easy_iterations
-    for before, after in zip(proximal, proximal[1:], strict=False):
+    for before, after in zip(steps, steps[1:], strict=False):
         assert after.increment == pytest.approx(before.increment * (2.0 if before.iterations <= easy else 1.0))
     newton = _newton_end_state()
     np.testing.assert_allclose(report.u, newton, atol=1e-5 * np.abs(newton).max())
 
 
 def test_a_held_phase_out_of_steps_stops_with_its_last_state():
-    with pytest.raises(run_module.ClosureFailed, match="not converged in 8 held steps"):
-        run_module.close_valve(None, replace(OPTIONS, hold=replace(OPTIONS.hold, max_steps=8)), setup=_block(),
+    with pytest.raises(run_module.ClosureFailed, match="not converged in 12 held steps"):
+        run_module.close_valve(None, replace(OPTIONS, hold=replace(OPTIONS.hold, max_steps=12)), setup=_block(),
                                progress=False)
 
 
@@ -80,7 +95,7 @@ def test_a_failed_held_step_is_retried_with_half_the_pseudo_step(monkeypatch):
     failures = []
 
     def fail_once(self, t_new, inertia_scale, rtol, max_iter):
-        if self.state.phase == "hold" and self.state.held_stage == 1 and not failures:
+        if self.state.phase == "hold" and self.state.held_stage == 2 and not failures:
             failures.append(inertia_scale)
             raise run_module.StepFailed("made to fail")
         return real(self, t_new, inertia_scale, rtol, max_iter)
@@ -94,11 +109,14 @@ def test_a_failed_held_step_is_retried_with_half_the_pseudo_step(monkeypatch):
     np.testing.assert_allclose(report.u, _newton_end_state(), atol=1e-5 * np.abs(report.u).max())
 
 
-@pytest.mark.parametrize("stop_at", [2, 12])  # inside the descend stage (with its controller), inside the proximal
-def test_a_run_stopped_in_the_held_phase_resumes_to_the_uninterrupted_result(tmp_path, monkeypatch, stop_at):
+@pytest.mark.parametrize("stage", ["descend", "settle", "proximal"])
+def test_a_run_stopped_in_the_held_phase_resumes_to_the_uninterrupted_result(tmp_path, monkeypatch, short_descend,
+                                                                              stage):
     monkeypatch.setattr(run_module, "_write_final", lambda *args: None)  # the stand-in has no chordae to draw
     whole = run_module.close_valve(None, OPTIONS, setup=_block(), progress=False)
-    assert whole.held_steps > 12
+    phases = [record.phase for record in whole.records if record.phase != "path"]
+    stop_at = phases.index(stage) + 2 if stage != "descend" else 2  # the held steps taken when the run is stopped
+    assert phases[stop_at - 1] == stage
 
     def stop_in_the_hold(state) -> None:
         if state.held_steps >= stop_at:
@@ -109,7 +127,8 @@ def test_a_run_stopped_in_the_held_phase_resumes_to_the_uninterrupted_result(tmp
                                callbacks=[stop_in_the_hold])
     kept = read_state(tmp_path / "state.npz")
     assert kept.phase == "hold" and kept.held_steps == stop_at
-    assert (kept.held_stage, kept.control is not None) == ((0, True) if stop_at < 10 else (1, False))
+    assert kept.held_stage == ("descend", "settle", "proximal").index(stage)
+    assert (kept.control is not None) == (stage != "proximal")  # an energy stage resumes with its controller
     resumed = run_module.close_valve(None, out=tmp_path, resume=True, setup=_block(), progress=False)
     assert resumed.converged and resumed.held_steps == whole.held_steps and resumed.iterations == whole.iterations
     np.testing.assert_allclose(resumed.u, whole.u, rtol=0.0, atol=1e-10 * np.abs(whole.u).max())

@@ -158,50 +158,57 @@ class StepOptions:
 
 @dataclass(frozen=True)
 class HoldOptions:
-    r"""The held load at the end time (:func:`skvalve.valve.run.close_valve`), in two stages, every accepted step a kept
-    state:
+    r"""The held load at the end time (:func:`skvalve.valve.run.close_valve`), in three stages, every accepted step a
+    kept state:
 
     1. *descend*: energy trust-region steps (:func:`~skvalve.fem.solvers.trust_region.trust_region`) on the
        element-projected tangent under Marquardt's diagonal shift, up to ``max_radius`` on any node, the chordae branch
-       points relaxed after each, until their energy drop stalls (the last 20 steps' average below ``stall_fraction``
-       of the stage's). One factorisation a step: it carries the leaflets the millimetres the path's damping left.
-    2. *proximal*: the path's steps with the load held, each a proximal step with the pseudo-mass :math:`c/h`
+       points relaxed after each; one factorisation a step carries the leaflets the millimetres the path's damping
+       left;
+    2. *settle*: the same on the symmetric tangent with a uniform (Levenberg) shift fitted to the radius and the
+       contact's stencils projected one by one (the sliding directions of a contact patch stay soft), while the
+       coaptation forms;
+    3. *proximal*: the path's steps with the load held, each a proximal step with the pseudo-mass :math:`c/h`
        (``StepOptions.damping`` over a pseudo-step :math:`h`) starting at the path's last step length and growing
        ``growth``-fold after each step of at most ``StepOptions.easy_iterations`` iterations (halved after a failed
        one), each solved to a tenth of the static residual it starts from, to ``rtol`` of the undamped problem.
 
-    Why not energy steps to the end (the *settle* stage of the version before): a follower pressure on the leaflets'
-    open surface has no potential, and energy steps circled the equilibrium (the 1.0 annuloplasty valve's held load:
-    400 steps between relative residuals 7e-4 and 1.8e-2, 5136 s, not converged). A proximal step's fixed points are
-    exactly the static equilibria, and its pseudo-mass keeps each step's problem well posed while :math:`h` is short;
-    as :math:`h` grows the steps become Newton's. From the last of those 400 states four proximal steps converged it
-    (61 s: 1.1e-3, 8.5e-5, 6.0e-6, 1.1e-6, 7.9e-8; pseudo-step 1 to 27). Why a descend stage first: from the path's end
-    (0.27) proximal steps took 15-16 Newton iterations to move the annuloplasty valve 0.7-1.2 mm (65-80 s a step, the
-    residual 0.27 -> 0.23 in three), and the earlier fixed pseudo-step (no growth) lowered the diseased valve's from
-    only 0.246 to 0.207 in 13 steps.
+    An energy stage hands on below ``proximal_below`` or when its energy drop stalls (the last 20 steps' average
+    below ``stall_fraction`` of the stage's). Why proximal steps at the end: a follower pressure on the leaflets'
+    open surface has no potential, and energy steps circle its equilibrium (the 1.0 annuloplasty valve's held load:
+    400 settle steps between relative residuals 7e-4 and 1.8e-2, 5136 s, not converged, with Newton's tries that
+    backtrack). A proximal step's fixed points are exactly the static equilibria, its pseudo-mass keeps each step's
+    problem well posed while :math:`h` is short, and as :math:`h` grows the steps become Newton's: from the last of
+    those 400 states four proximal steps converged it (61 s: 1.1e-3, 8.5e-5, 6.0e-6, 1.1e-6, 7.9e-8). Why not
+    proximal steps sooner: from the descend stage's end (coaptation still forming, relative residual 0.85 and 9.9)
+    they took 18-32 Newton iterations each on the 1.0 diseased valve (0.85 -> 0.037 in 4 steps, 1144 s) and failed
+    twice in 40 on the annuloplasty valve, where settle steps cost one factorisation each.
 
     rtol
         the undamped, static residual asked for (relative to the end load's nodal pressure forces).
     max_steps
-        accepted held steps in all before the run stops with its last state (the descend stage hands on after at most
-        half of them); 0: no held phase (the path only).
+        accepted held steps in all before the run stops with its last state; 0: no held phase (the path only).
     max_radius
-        the most any node moves in one descend step (mm; the first radius is a quarter of it).
+        the most any node moves in one energy step (mm; the first radius is a quarter of it).
     stall_fraction
-        when the descend stage hands on (above).
+        when an energy stage stalls (above).
+    proximal_below
+        the relative residual below which the energy stages hand on to the proximal steps. 1e-2: where the settle stage
+        began to circle on the 1.0 valves.
     growth
         the proximal pseudo-step's factor after an easy step. 3: the damping falls a decade in about two steps, so a
         state near the equilibrium is reached by Newton's steps within a few, while a failed step costs one halving.
     """
 
     rtol: float = 1e-6
-    max_steps: int = 400
+    max_steps: int = 600
     max_radius: float = 1.0
     stall_fraction: float = 0.2
+    proximal_below: float = 1e-2
     growth: float = 3.0
 
     def __post_init__(self) -> None:
-        for name in ("rtol", "max_radius"):
+        for name in ("rtol", "max_radius", "proximal_below"):
             _positive("HoldOptions", name, getattr(self, name))
         if not 0.0 <= self.stall_fraction < 1.0:
             raise ValueError(f"HoldOptions.stall_fraction must lie in [0, 1); got {self.stall_fraction!r}")
@@ -211,7 +218,8 @@ class HoldOptions:
             raise ValueError(f"HoldOptions.max_steps must be an integer >= 0; got {self.max_steps!r}")
 
 
-#: fields of :class:`HoldOptions` in kept states of earlier versions (the settle stage's), dropped on reading
+#: fields of :class:`HoldOptions` in kept states of earlier versions (Newton's tries in the settle stage), dropped on
+#: reading
 RETIRED_HOLD_FIELDS = ("newton_below",)
 
 

@@ -13,14 +13,16 @@ grows after easy steps and halves after failed ones. The line search's merit is 
 follower pressure's work along the ray, by the trapezoidal rule (the pressure on the leaflets' open surface has no
 potential). The chordae branch points are swept to their own balance (with the step's pseudo-mass) on the first
 iterate and after every accepted iteration (:func:`hub_relaxation`): when the papillary tips move, the cables' pull on
-them is most of the residual. Held load (:class:`~skvalve.valve.options.HoldOptions`): the same steps with the load
-held at the end time, each a proximal step :math:`\min_u \Pi(u) + \tfrac{c}{2h}\sum_i V_i|u_i - u_i^k|^2` whose
-pseudo-step :math:`h` starts at the path's last step length and grows ``HoldOptions.growth``-fold after every easy
-step (halved after a failed one), until the static residual is below ``rtol`` (1e-6) of the end load's nodal forces.
-A proximal step cannot circle: its fixed points are exactly the static equilibria, and the pseudo-mass makes each
-step's problem well posed while the pseudo-step is short, so Newton's iterations converge where the undamped
-problem's energy model (the follower pressure on an open surface has no potential) would circle; as :math:`h` grows
-the steps become Newton's steps on the undamped problem.
+them is most of the residual. Held load (:class:`~skvalve.valve.options.HoldOptions`): energy trust-region stages
+(:func:`energy_stages`: *descend* on the element-projected tangent, *settle* on the symmetric one; steps of at most a
+millimetre, accepted by the energy they release) while the coaptation forms, then, below ``proximal_below`` or when
+their energy drop stalls, the path's own steps with the load held: each a proximal step
+:math:`\min_u \Pi(u) + \tfrac{c}{2h}\sum_i V_i|u_i - u_i^k|^2` whose pseudo-step :math:`h` starts at the path's last
+step length and grows ``growth``-fold after every easy step (halved after a failed one), until the static residual is
+below ``rtol`` (1e-6) of the end load's nodal forces. The follower pressure on an open surface has no potential, so
+energy steps can circle its equilibrium; a proximal step's fixed points are exactly the static equilibria, its
+pseudo-mass keeps each step's problem well posed while :math:`h` is short, and as :math:`h` grows the steps become
+Newton's.
 
 Output in ``out``: ``state.npz`` after every accepted step (atomic, :mod:`skvalve.valve.state`; ``resume=True``
 continues from it and repeats the uninterrupted run), ``closure.log`` (one line per step), and at the end
@@ -32,13 +34,14 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
 from tqdm.auto import tqdm
 
+from ..fem.contact import IPCContact
 from ..fem.elements.fbar import FBarTerm
 from ..fem.elements.truss import Truss
 from ..fem.errors import ConvergenceError, NonPositiveJacobianError, SingularSystemError, SolverError, StateRefused
@@ -55,7 +58,7 @@ from .outputs import ClosureWriter
 from .setup import ValveSetup, smallest_corner_jacobian, valve_setup
 from .state import KeptState, read_state, write_state
 
-__all__ = ["ClosureFailed", "CloseReport", "StepRecord", "close_valve", "descend_stage", "hub_relaxation",
+__all__ = ["ClosureFailed", "CloseReport", "StepRecord", "close_valve", "energy_stages", "hub_relaxation",
            "relative_residual"]
 
 logger = logging.getLogger("skvalve.valve")
@@ -70,9 +73,10 @@ class ClosureFailed(SolverError):
 
 @dataclass
 class StepRecord:
-    """One accepted step: phase (``path``, or the held load's ``descend`` and ``proximal`` stages), step time, step
-    length (path), trust radius (descend) or pseudo-step (proximal), iterations (descend: the trust region's tries,
-    rejected ones included), static relative residual, contact pairs, seconds, and the largest nodal motion (mm)."""
+    """One accepted step: phase (``path``, or the held load's ``descend``, ``settle`` and ``proximal`` stages), step
+    time, step length (path), trust radius (descend, settle) or pseudo-step (proximal), iterations (descend, settle: the
+    trust region's tries, rejected ones included), static relative residual, contact pairs, seconds, and the largest
+    nodal motion (mm)."""
 
     phase: str
     t: float
@@ -84,7 +88,7 @@ class StepRecord:
     moved: float = float("nan")
 
     def line(self) -> str:
-        size = {"path": "dt", "descend": "radius"}.get(self.phase, "h")
+        size = {"path": "dt", "proximal": "h"}.get(self.phase, "radius")
         return (f"{self.phase} t={self.t:.6g} {size}={self.increment:.3g} iterations={self.iterations} "
                 f"relative_residual={self.relative_residual:.3e} contact_pairs={self.contact_pairs} "
                 f"max_du={self.moved:.3g} seconds={self.seconds:.2f}")
@@ -245,7 +249,7 @@ class _Run:
             bar.set_postfix(it=len(history), res=f"{relative:.1e}", pairs=pairs, dt=f"{step_length:.2g}")
 
     def hold(self, bar) -> None:
-        """The held load (module docstring): the descend stage, then proximal steps to ``hold.rtol``."""
+        """The held load (module docstring): the descend and settle stages, then proximal steps to ``hold.rtol``."""
         hold, s = self.options.hold, self.state
         if hold.max_steps == 0:  # the path only (e.g. a run that stops part-way along the load path)
             return
@@ -253,15 +257,19 @@ class _Run:
             # before the pressure: leaflets hanging from chordae and annulus have no unique static state to hold
             logger.warning("%s: no pressure at step time %.6g: the path only, no held load", s.input, self.end)
             return
-        if s.phase == "hold" and s.held_stage == 0:
-            self.descend(bar)
+        stages = energy_stages(hold, self.setup.load_norm, self.options.solver)
+        while s.phase == "hold" and s.held_stage < len(stages):
+            self.energy_stage(bar, stages[s.held_stage])
         while s.phase == "hold":
             self.proximal_step(bar)
 
-    def descend(self, bar) -> None:
-        """The descend stage: energy trust-region steps of at most ``max_radius`` until their energy drop stalls."""
-        s = self.state
+    def energy_stage(self, bar, options: TrustRegionOptions) -> None:
+        """One of the energy trust-region stages, to its hand-on (``proximal_below``, a stall or its share of the
+        held steps); the next stage goes on from its last state."""
+        hold, s = self.options.hold, self.state
         clock = [time.perf_counter()]
+        stage = s.held_stage
+        name = ENERGY_STAGES[stage]
 
         def keep_step(event: TrustRegionStep) -> None:
             attempts = event.control.attempts - (s.control.attempts if s.control is not None else 0)
@@ -269,27 +277,29 @@ class _Run:
             s.held_steps += 1
             s.iterations += attempts
             pairs = self.setup.contact.active_pairs(event.u, self.end)
-            self.keep(StepRecord("descend", self.end, event.control.radius, attempts, s.relative_residual, pairs,
+            self.keep(StepRecord(name, self.end, event.control.radius, attempts, s.relative_residual, pairs,
                                  time.perf_counter() - clock[0], event.largest))
             clock[0] = time.perf_counter()
-            bar.set_postfix(stage=1, held=s.held_steps, res=f"{s.relative_residual:.1e}", pairs=pairs)
+            bar.set_postfix(stage=name, held=s.held_steps, res=f"{s.relative_residual:.1e}", pairs=pairs)
 
+        # the held steps left to the run, counted from this stage's start (a resumed stage has taken control.steps)
+        left = hold.max_steps - (s.held_steps - (s.control.steps if s.control is not None else 0))
+        options = replace(options, max_steps=max(min(options.max_steps, left), 1))
         try:
-            result = trust_region(self.problem, self.end, s.u, descend_stage(self.options.hold, self.setup.load_norm,
-                                                                             self.options.solver),
+            result = trust_region(self.problem, self.end, s.u, options,
                                   callbacks=[keep_step], progress=False, relax=hub_relaxation(self.setup),
                                   control=s.control)
-        except ConvergenceError as err:  # out of steps or no step found: the proximal steps go on from the last one
-            logger.info("%s: the descend stage stopped (%s)", s.input, err)
+        except ConvergenceError as err:  # stalled or out of steps: the next stage goes on from the last step
+            logger.info("%s: the %s stage stopped (%s)", s.input, name, err)
             result = None
         if result is not None:
             s.u = result.u
         residual, _ = self.problem.assemble(s.u, self.end, tangent=False)
         s.relative_residual = relative_residual(self.setup, residual)
-        s.held_stage, s.control = 1, None
-        if result is not None and result.converged:
+        s.held_stage, s.control = stage + 1, None
+        if s.relative_residual <= hold.rtol:
             s.phase = "done"
-        logger.info("%s: proximal steps from relative residual %.3e", s.input, s.relative_residual)
+        logger.info("%s: %s stage ends at relative residual %.3e", s.input, name, s.relative_residual)
         self.keep(None)
 
     def proximal_step(self, bar) -> None:
@@ -324,13 +334,22 @@ class _Run:
         bar.set_postfix(stage=2, held=s.held_steps, it=len(history), res=f"{relative:.1e}", pairs=pairs, h=f"{h:.2g}")
 
 
-def descend_stage(options: HoldOptions, load_norm: float, solver: str | None = None) -> TrustRegionOptions:
-    """The held load's descend stage (:class:`~skvalve.valve.options.HoldOptions`): trust-region steps on the
-    element-projected tangent with Marquardt's diagonal shift, scaled into a radius of at most ``max_radius``, until the
-    energy drop stalls; residuals relative to the end load's nodal forces."""
-    return TrustRegionOptions(project=True, stall_fraction=options.stall_fraction, radius=0.25 * options.max_radius,
-                              max_radius=options.max_radius, rtol=options.rtol, reference=load_norm,
-                              max_steps=max(1, options.max_steps // 2), max_strain_increment=None, solver=solver)
+#: the held load's energy stages, in order (:func:`energy_stages`); the proximal steps follow them
+ENERGY_STAGES = ("descend", "settle")
+
+
+def energy_stages(options: HoldOptions, load_norm: float, solver: str | None = None) -> list[TrustRegionOptions]:
+    """The held load's energy trust-region stages (:class:`~skvalve.valve.options.HoldOptions`), each ending below
+    ``proximal_below`` or when its energy drop stalls: *descend* (the element-projected tangent under Marquardt's
+    diagonal shift, steps scaled into the radius) and *settle* (the symmetric tangent, a uniform shift fitted to the
+    radius, the IPC contact's stencils projected one by one); residuals relative to the end load's nodal forces."""
+    common = {"radius": 0.25 * options.max_radius, "max_radius": options.max_radius, "rtol": options.proximal_below,
+              "reference": load_norm, "max_steps": options.max_steps, "max_strain_increment": None,
+              "stall_fraction": options.stall_fraction, "solver": solver}
+    descend = TrustRegionOptions(project=True, **common)
+    settle = TrustRegionOptions(project=False, fit_radius=3, shift_scaling="uniform", project_terms=(IPCContact.name,),
+                                **common)
+    return [descend, settle]
 
 
 def hub_relaxation(setup: ValveSetup, tol: float = 1e-9) -> BlockRelaxation | None:
