@@ -223,7 +223,6 @@ class HoldOptions:
 RETIRED_HOLD_FIELDS = ("newton_below",)
 
 
-
 @dataclass(frozen=True)
 class CloseOptions:
     """Everything :func:`~skvalve.valve.run.close_valve` needs; ``end`` None: the input's step time."""
