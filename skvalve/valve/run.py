@@ -206,15 +206,16 @@ class _Run:
             self.last_error = err
             return None
 
-    def accept(self, u: np.ndarray, t: float, residual: np.ndarray, history: list) -> float:
-        """Commit an accepted step and return its static relative residual."""
+    def accept(self, u: np.ndarray, t: float, residual: np.ndarray, history: list) -> tuple[float, float]:
+        """Commit an accepted step; return its static relative residual and its largest nodal motion."""
         problem = self.problem
         problem.commit()  # its state was vetted in attempt()
         relative = relative_residual(self.setup, residual)
         s = self.state
+        moved = float(np.max(np.abs(u - s.u), initial=0.0))
         s.u, s.t, s.relative_residual = u, float(t), relative
         s.iterations += len(history)
-        return relative
+        return relative, moved
 
     # ------------------------------------------------------------ phases
     def path(self, bar) -> None:
@@ -234,8 +235,7 @@ class _Run:
                 continue
             u, residual, history = outcome
             step_length = t_new - s.t
-            moved = float(np.max(np.abs(u - s.u))) if u.size else 0.0
-            relative = self.accept(u, t_new, residual, history)
+            relative, moved = self.accept(u, t_new, residual, history)
             s.steps += 1
             grow = len(history) <= opts.easy_iterations
             base = dt if cut else step_length  # a step cut short by a break leaves the planned length as it was
@@ -258,12 +258,13 @@ class _Run:
             logger.warning("%s: no pressure at step time %.6g: the path only, no held load", s.input, self.end)
             return
         stages = energy_stages(hold, self.setup.load_norm, self.options.solver)
+        hubs = hub_relaxation(self.setup)
         while s.phase == "hold" and s.held_stage < len(stages):
-            self.energy_stage(bar, stages[s.held_stage])
+            self.energy_stage(bar, stages[s.held_stage], hubs)
         while s.phase == "hold":
             self.proximal_step(bar)
 
-    def energy_stage(self, bar, options: TrustRegionOptions) -> None:
+    def energy_stage(self, bar, options: TrustRegionOptions, hubs: BlockRelaxation | None) -> None:
         """One of the energy trust-region stages, to its hand-on (``proximal_below``, a stall or its share of the
         held steps); the next stage goes on from its last state."""
         hold, s = self.options.hold, self.state
@@ -287,7 +288,7 @@ class _Run:
         options = replace(options, max_steps=max(min(options.max_steps, left), 1))
         try:
             result = trust_region(self.problem, self.end, s.u, options,
-                                  callbacks=[keep_step], progress=False, relax=hub_relaxation(self.setup),
+                                  callbacks=[keep_step], progress=False, relax=hubs,
                                   control=s.control)
         except ConvergenceError as err:  # stalled or out of steps: the next stage goes on from the last step
             logger.info("%s: the %s stage stopped (%s)", s.input, name, err)
@@ -324,8 +325,7 @@ class _Run:
                                     f"{opts.smallest:g}: {self.last_error}")
             return
         u, residual, history = outcome
-        moved = float(np.max(np.abs(u - s.u))) if u.size else 0.0
-        relative = self.accept(u, self.end, residual, history)
+        relative, moved = self.accept(u, self.end, residual, history)
         s.held_steps += 1
         s.increment = h * hold.growth if len(history) <= opts.easy_iterations else h
         pairs = self.setup.contact.active_pairs(u, self.end)

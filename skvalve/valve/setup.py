@@ -70,7 +70,7 @@ def valve_setup(source: str | Path | AbaqusModel, options: CloseOptions | None =
         problem.add_term(CornerBarrier(problem.space, moduli, options.model.corner_threshold))
     if model.obstacles and c.tie_within > 0.0:
         # an arm grips from the step in which it starts to close (the leaflets may press on it before)
-        grips = [arm.turns_from(model.steps) for arm in model.arms] if len(model.arms) == len(model.obstacles) else None
+        grips = [arm.turns_from(model.steps) for arm in model.arms]
         problem.add_term(ObstacleTie(problem.space, contact.nodes, contact.area[contact.nodes], model.obstacles,
                                      capture=c.tie_within, stiffness=TIE_FACTOR * peak / c.dhat, capture_from=grips))
     leaflet = np.full(model.mesh.p.shape[1], -1, dtype=np.int64)

@@ -41,10 +41,9 @@ class KeptState:
     """A closure state: step time ``t``, displacement ``u``, the controller, the input and the options.
 
     ``phase`` is ``"path"`` (loading), ``"hold"`` (held load) or ``"done"``; ``increment`` the next path step's length
-    or proximal step's pseudo-step; ``held_stage`` the held load's stage (0 descend, 1 proximal; a state of the version
-    before in its *settle* stage resumes with proximal steps) and ``control`` the descend stage's trust-region
-    controller after its last step (None before its first and after it); ``relative_residual`` the static residual at
-    ``u``.
+    or proximal step's pseudo-step; ``held_stage`` the held load's stage (0 descend, 1 settle, 2 proximal) and
+    ``control`` the energy stage's trust-region controller after its last step (None before a stage's first step and in
+    the proximal stage); ``relative_residual`` the static residual at ``u``.
     """
 
     t: float
