@@ -21,8 +21,10 @@ from skvalve.fem.solvers.incremental import (
     FIRST_SHIFT,
     SHIFT_GROWTH,
     IncrementalOptions,
+    StepFailed,
     _past_the_minimum,
     incremental_potential,
+    minimise_step,
     shifted_newton,
 )
 from skvalve.materials import NeoHookean
@@ -247,3 +249,28 @@ def test_the_iteration_limit_tests_the_last_iterate_and_spares_a_contracting_ite
         np.testing.assert_array_equal(capped.solutions[-1], free.solutions[-1])
     with pytest.raises(ConvergenceError, match="2 iterations"):
         stretched(1)
+
+
+def test_a_step_out_of_iterations_carries_its_last_iterate_where_the_terms_were_last_assembled():
+    """The stretched block's step held to one iteration fails; it carries its last iterate (after two iterations, the
+    second spared because the first contracted): the static residual there is the problem's own, its history has the
+    two iterations, and the barrier term saw that state last with a tangent, so that committing takes it."""
+    solid, contact, _ = _block_over_obstacle(drop=0.1, gap=0.05, dhat=0.02, rollers=True)
+    seen = []
+    assemble = contact.assemble
+
+    def recorded(u, t, tangent, step):
+        if tangent:
+            seen.append(np.array(u, copy=True))
+        return assemble(u, t, tangent, step)
+
+    contact.assemble = recorded
+    u_old = np.zeros(solid.space.n_dofs)
+    options = IncrementalOptions(rtol=1e-14, max_iter=1, predictor=False)
+    with pytest.raises(StepFailed, match="no convergence") as failed:
+        minimise_step(solid, u_old, 0.0, 1.0, u_old, np.zeros_like(u_old), 1, options, "pardiso")
+    u, residual, history = failed.value.last
+    assert 1 <= len(history) <= 2 and np.abs(u).max() > 0.0
+    np.testing.assert_array_equal(seen[-1], u)
+    np.testing.assert_allclose(residual, solid.assemble(u, 1.0, tangent=False)[0], rtol=0.0,
+                               atol=1e-12 * np.abs(residual).max())

@@ -157,3 +157,58 @@ def test_end_load_norm_is_the_pressure_nodal_forces_norm():
     assert end_load_norm(setup.problem, 0.5) == pytest.approx(0.5 * 0.375 * PRESSURE, rel=1e-12)  # ramped
     with pytest.raises(ValueError, match="no pressure"):
         end_load_norm(setup.problem, 0.0)
+
+
+
+def _proximal_steps_out_of_iterations(monkeypatch, first_bar: float | None = None) -> list[float]:
+    """Hold every proximal step to one Newton iteration (two while contracting) against a tolerance it cannot reach,
+    so that each runs out of iterations; ``first_bar``: the residual the first try's last iterate must get below.
+    Returns the pseudo-mass scale of each try."""
+    real_step, real_attempt = run_module._Run.step, run_module._Run.attempt
+    tries = []
+
+    def out_of_iterations(self, t_new, inertia_scale, rtol, max_iter):
+        proximal = self.state.phase == "hold" and self.state.held_stage == 2
+        return real_step(self, t_new, inertia_scale, 1e-14 if proximal else rtol, 1 if proximal else max_iter)
+
+    def bar(self, t_new, inertia_scale, rtol, max_iter, inexact_below=None):
+        if inexact_below is not None:
+            tries.append(inertia_scale)
+            if len(tries) == 1 and first_bar is not None:
+                inexact_below = first_bar
+        return real_attempt(self, t_new, inertia_scale, rtol, max_iter, inexact_below)
+
+    monkeypatch.setattr(run_module._Run, "step", out_of_iterations)
+    monkeypatch.setattr(run_module._Run, "attempt", bar)
+    return tries
+
+
+def test_a_proximal_step_out_of_iterations_is_taken_at_its_last_iterate_when_that_lowers_the_residual(monkeypatch):
+    """Proximal steps that run out of iterations are each taken at their last iterate: the static residual falls from
+    step to step, the pseudo-step stays as it was, none is cut back, and the run ends at Newton's state."""
+    _proximal_steps_out_of_iterations(monkeypatch)
+    report = run_module.close_valve(None, OPTIONS, setup=_block(), progress=False)
+    held = [record for record in report.records if record.phase == "proximal"]
+    assert len(held) >= 3 and report.failed_steps == 0
+    assert all(record.iterations <= 2 for record in held)
+    inexact = [record for record in held if not record.exact]
+    assert len(inexact) >= 3 and all(record.relative_residual > 1e-10 for record in inexact)
+    for before, after in zip(held, held[1:], strict=False):  # an inexact step leaves the pseudo-step as it was
+        assert after.increment == pytest.approx(before.increment * (1.0 if not before.exact else 2.0))
+    assert "proximal (inexact) t=1 h=0.25 iterations=2" in inexact[0].line()
+    residuals = [record.relative_residual for record in held]
+    assert all(after < before for before, after in zip(residuals, residuals[1:], strict=False))
+    assert report.converged
+    np.testing.assert_allclose(report.u, _newton_end_state(), atol=1e-5 * np.abs(report.u).max())
+
+
+def test_an_inexact_step_that_does_not_lower_the_residual_enough_is_refused(monkeypatch):
+    """The first proximal step's last iterate must get below a residual it cannot reach: it is refused, the terms are
+    rewound and the step is retried from the same state at half the pseudo-step; the run still converges."""
+    tries = _proximal_steps_out_of_iterations(monkeypatch, first_bar=1e-12)
+    report = run_module.close_valve(None, OPTIONS, setup=_block(), progress=False)
+    assert report.failed_steps == 1 and tries[1] == pytest.approx(2.0 * tries[0])  # pseudo-mass c/h: h halved
+    held = [record for record in report.records if record.phase == "proximal"]
+    assert held[0].increment == pytest.approx(0.125)
+    assert report.converged
+    np.testing.assert_allclose(report.u, _newton_end_state(), atol=1e-5 * np.abs(report.u).max())

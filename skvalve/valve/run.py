@@ -19,10 +19,12 @@ millimetre, accepted by the energy they release) while the coaptation forms, the
 their energy drop stalls, the path's own steps with the load held: each a proximal step
 :math:`\min_u \Pi(u) + \tfrac{c}{2h}\sum_i V_i|u_i - u_i^k|^2` whose pseudo-step :math:`h` starts at the path's last
 step length and grows ``growth``-fold after every easy step (halved after a failed one), until the static residual is
-below ``rtol`` (1e-6) of the end load's nodal forces. The follower pressure on an open surface has no potential, so
-energy steps can circle its equilibrium; a proximal step's fixed points are exactly the static equilibria, its
-pseudo-mass keeps each step's problem well posed while :math:`h` is short, and as :math:`h` grows the steps become
-Newton's.
+below ``rtol`` (1e-6) of the end load's nodal forces. Each step is solved to a tenth of the static residual it starts
+from; a step whose iterations run out is taken inexactly, at its last iterate, when that lowers the static residual
+(the pseudo-step then stays as it was), as inexact proximal point methods allow. The follower pressure on an open
+surface has no potential, so energy steps can circle its equilibrium; a proximal step's fixed points are exactly the
+static equilibria, its pseudo-mass keeps each step's problem well posed while :math:`h` is short, and as :math:`h`
+grows the steps become Newton's.
 
 Output in ``out``: ``state.npz`` after every accepted step (atomic, :mod:`skvalve.valve.state`; ``resume=True``
 continues from it and repeats the uninterrupted run), ``closure.log`` (one line per step), and at the end
@@ -75,8 +77,9 @@ class ClosureFailed(SolverError):
 class StepRecord:
     """One accepted step: phase (``path``, or the held load's ``descend``, ``settle`` and ``proximal`` stages), step
     time, step length (path), trust radius (descend, settle) or pseudo-step (proximal), iterations (descend, settle: the
-    trust region's tries, rejected ones included), static relative residual, contact pairs, seconds, and the largest
-    nodal motion (mm)."""
+    trust region's tries, rejected ones included), static relative residual, contact pairs, seconds, the largest
+    nodal motion (mm), and whether the step was solved to its tolerance (``exact``; False for a proximal step taken at
+    its last iterate)."""
 
     phase: str
     t: float
@@ -86,10 +89,12 @@ class StepRecord:
     contact_pairs: int
     seconds: float
     moved: float = float("nan")
+    exact: bool = True
 
     def line(self) -> str:
         size = {"path": "dt", "proximal": "h"}.get(self.phase, "radius")
-        return (f"{self.phase} t={self.t:.6g} {size}={self.increment:.3g} iterations={self.iterations} "
+        phase = self.phase if self.exact else f"{self.phase} (inexact)"
+        return (f"{phase} t={self.t:.6g} {size}={self.increment:.3g} iterations={self.iterations} "
                 f"relative_residual={self.relative_residual:.3e} contact_pairs={self.contact_pairs} "
                 f"max_du={self.moved:.3g} seconds={self.seconds:.2f}")
 
@@ -130,11 +135,13 @@ def relative_residual(setup: ValveSetup, residual: np.ndarray) -> float:
 
 
 class _Outcome(NamedTuple):
-    """A step's end: state, static residual (all dofs), iteration history."""
+    """A step's end: state, static residual (all dofs), iteration history; ``exact`` False for the last iterate of a
+    step whose iterations ran out (:meth:`_Run.inexact`)."""
 
     u: np.ndarray
     residual: np.ndarray
     history: list[dict]
+    exact: bool = True
 
 
 class _Run:
@@ -191,20 +198,47 @@ class _Run:
                                              carry=self.carry)
         return u, residual, history
 
-    def attempt(self, t_new: float, inertia_scale: float, rtol: float, max_iter: int) -> _Outcome | None:
+    def attempt(self, t_new: float, inertia_scale: float, rtol: float, max_iter: int,
+                inexact_below: float | None = None) -> _Outcome | None:
         """:meth:`step`, or ``None`` after rewinding the terms when it fails. A converged step whose state a term
         refuses (:class:`~skvalve.fem.errors.StateRefused`: an intersection among collision primitives that the
-        barrier excludes) fails too, so the step is cut back instead of ending the run."""
+        barrier excludes) fails too, so the step is cut back instead of ending the run.
+
+        ``inexact_below``: a step whose iterations ran out is still taken at its last iterate when the terms accept
+        that state and its static relative residual is below this (an inexact proximal step)."""
         try:
             outcome = _Outcome(*self.step(t_new, inertia_scale, rtol, max_iter))
             self.problem.check_state(outcome.u, t_new)
             return outcome
         except (StepFailed, NonPositiveJacobianError, SingularSystemError, StateRefused, np.linalg.LinAlgError) as err:
+            inexact = self.inexact(err, t_new, inexact_below)
+            if inexact is not None:
+                return inexact
             self.problem.rewind()
             self.failed += 1
             logger.info("step to t=%.6g failed: %s", t_new, err)
             self.last_error = err
             return None
+
+    def inexact(self, err: Exception, t_new: float, below: float | None) -> _Outcome | None:
+        """The last iterate of a step that ran out of iterations (:attr:`StepFailed.last`), where it lowers the static
+        relative residual below ``below`` and the terms accept it; else ``None``."""
+        last = getattr(err, "last", None)
+        if below is None or last is None:
+            return None
+        outcome = _Outcome(*last, exact=False)
+        relative = relative_residual(self.setup, outcome.residual)
+        if not relative < below:
+            logger.info("step to t=%.6g: its last iterate (relative residual %.3e) is not below %.3e", t_new,
+                        relative, below)
+            return None
+        try:
+            self.problem.check_state(outcome.u, t_new)
+        except StateRefused:
+            return None
+        logger.info("step to t=%.6g: %s; its last iterate taken (relative residual %.3e < %.3e)", t_new, err,
+                    relative, below)
+        return outcome
 
     def accept(self, u: np.ndarray, t: float, residual: np.ndarray, history: list) -> tuple[float, float]:
         """Commit an accepted step; return its static relative residual and its largest nodal motion."""
@@ -233,7 +267,7 @@ class _Run:
                     raise ClosureFailed(f"{s.input}: load step {s.steps + 1} from step time {s.t:.6g} failed at "
                                         f"every length down to {opts.smallest:g}: {self.last_error}")
                 continue
-            u, residual, history = outcome
+            u, residual, history, _ = outcome  # no inexact path steps
             step_length = t_new - s.t
             relative, moved = self.accept(u, t_new, residual, history)
             s.steps += 1
@@ -317,20 +351,20 @@ class _Run:
         h = s.increment
         # the step's own tolerance: a tenth of the static residual it starts from, down to half the goal
         rtol = max(0.5 * hold.rtol, 0.1 * s.relative_residual)
-        outcome = self.attempt(self.end, opts.damping / h, rtol, opts.max_iter)
+        outcome = self.attempt(self.end, opts.damping / h, rtol, opts.max_iter, inexact_below=s.relative_residual)
         if outcome is None:
             s.increment = 0.5 * h
             if s.increment < opts.smallest:
                 raise ClosureFailed(f"{s.input}: held step {s.held_steps + 1} failed at every pseudo-step down to "
                                     f"{opts.smallest:g}: {self.last_error}")
             return
-        u, residual, history = outcome
+        u, residual, history, exact = outcome
         relative, moved = self.accept(u, self.end, residual, history)
         s.held_steps += 1
-        s.increment = h * hold.growth if len(history) <= opts.easy_iterations else h
+        s.increment = h * hold.growth if exact and len(history) <= opts.easy_iterations else h
         pairs = self.setup.contact.active_pairs(u, self.end)
         self.keep(StepRecord("proximal", self.end, h, len(history), relative, pairs, time.perf_counter() - clock,
-                             moved))
+                             moved, exact))
         bar.set_postfix(stage=2, held=s.held_steps, it=len(history), res=f"{relative:.1e}", pairs=pairs, h=f"{h:.2g}")
 
 

@@ -128,7 +128,15 @@ class IncrementalOptions:
 
 
 class StepFailed(Exception):
-    """A load step whose minimisation did not converge (the caller rewinds and cuts the step back)."""
+    """A load step whose minimisation did not converge (the caller rewinds and cuts the step back).
+
+    ``last``: where the iterations ran out (or stalled) after at least one accepted iterate, that iterate as
+    ``(u, static residual, history)``; the terms were last assembled with a tangent there, so ``problem.commit()``
+    accepts it (an inexact step, e.g. a proximal step that lowered the static residual). ``None`` otherwise."""
+
+    def __init__(self, message: str, last: tuple[np.ndarray, np.ndarray, list[dict]] | None = None) -> None:
+        super().__init__(message)
+        self.last = last
 
 
 def incremental_potential(problem: Problem, steps=10, *, mass: np.ndarray | None = None, time_step: float = 1.0,
@@ -287,7 +295,8 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
         if norm <= max(opts.rtol * reference, opts.atol):
             return u, residual, history
         if iteration >= opts.max_iter and not (iteration < 2 * opts.max_iter and norm <= CONTRACTING * before):
-            raise StepFailed(f"no convergence in {iteration} iterations (relative residual {norm / reference:.3e})")
+            raise StepFailed(f"no convergence in {iteration} iterations (relative residual {norm / reference:.3e})",
+                             last=(u, residual, history) if history else None)
         iteration, before = iteration + 1, norm
         clock = time.perf_counter()
         if shifted:
