@@ -252,9 +252,9 @@ def test_the_iteration_limit_tests_the_last_iterate_and_spares_a_contracting_ite
 
 
 def test_a_step_out_of_iterations_carries_its_last_iterate_where_the_terms_were_last_assembled():
-    """The stretched block's step held to one iteration fails; it carries its last iterate (after two iterations, the
-    second spared because the first contracted): the static residual there is the problem's own, its history has the
-    two iterations, and the barrier term saw that state last with a tangent, so that committing takes it."""
+    """The block pressed onto an obstacle, its step held to one iteration (two while contracting) against a tolerance
+    it cannot reach, fails and carries its last iterate: the static residual there is the problem's own, its history
+    has the iterations taken, and the barrier term saw that state last with a tangent, so that committing takes it."""
     solid, contact, _ = _block_over_obstacle(drop=0.1, gap=0.05, dhat=0.02, rollers=True)
     seen = []
     assemble = contact.assemble

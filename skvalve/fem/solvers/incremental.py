@@ -130,7 +130,7 @@ class IncrementalOptions:
 class StepFailed(Exception):
     """A load step whose minimisation did not converge (the caller rewinds and cuts the step back).
 
-    ``last``: where the iterations ran out (or stalled) after at least one accepted iterate, that iterate as
+    ``last``: where the iterations ran out after at least one accepted iterate, that iterate as
     ``(u, static residual, history)``; the terms were last assembled with a tangent there, so ``problem.commit()``
     accepts it (an inexact step, e.g. a proximal step that lowered the static residual). ``None`` otherwise."""
 
