@@ -49,6 +49,24 @@ def test_captured_vertices_follow_the_obstacles_rigid_motion():
     assert np.abs(result.u()[: solid.space.n_u].reshape(-1, 3) - exact).max() < 1e-9
 
 
+def test_captured_vertices_are_pushed_by_the_obstacles_rigid_motion():
+    """``pushed``: a vertex captured at 0.25 starts a step to 0.75 moved as its point of the plate moves, in closed
+    form c + R(0.45) R(0.15)^T (X - c - 0.25 a) + 0.75 a - X; nothing before a capture, nothing where the plate does
+    not move."""
+    mesh, solid, tie = _tied_cube()
+    u = np.zeros(solid.space.n_dofs)
+    assert tie.pushed(u, 0.25, 0.75) is None
+    tie.assemble(u, 0.25, True, None)
+    tie.commit()
+    dofs, increments = tie.pushed(u, 0.25, 0.75)
+    X = mesh.p.T[tie.captured]  # fixed in the plate's frame from 0.25: y = c + R(t)(Y - c) + a t
+    a = np.array([0.3, -0.2, 0.1])
+    reference = CENTRE + (X - CENTRE - 0.25 * a) @ _rotation_z(0.15) @ _rotation_z(0.45).T + 0.75 * a - X
+    np.testing.assert_allclose(increments.reshape(-1, 3), reference, atol=1e-12)
+    assert np.array_equal(dofs, (3 * tie.captured[:, None] + np.arange(3)).ravel())
+    assert not np.any(tie.pushed(u, 0.75, 0.75)[1])
+
+
 def test_nothing_is_captured_before_the_obstacle_is_active_or_out_of_reach():
     _, solid, tie = _tied_cube(active_from=0.5)
     u = np.zeros(solid.space.n_dofs)

@@ -289,6 +289,33 @@ class Problem:
                 fraction = min(fraction, value)
         return fraction
 
+    def pushed(self, u: np.ndarray, t0: float, t1: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """The free dofs the terms' prescribed motion pushes from ``t0`` to ``t1`` at ``u``, with their nonzero
+        increments (:meth:`~skvalve.fem.terms.Term.pushed`; a dof two terms push takes the first one's); ``None`` when
+        none moves."""
+        return self._free_increments("pushed", (u, t0, t1))
+
+    def crossed(self, u0: np.ndarray, t0: float, u1: np.ndarray, t1: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """The free dofs the straight move from ``(u0, t0)`` to ``(u1, t1)`` crosses, with increments from ``u0`` that
+        let them ride with what crosses them (:meth:`~skvalve.fem.terms.Term.crossed`); ``None`` when none."""
+        return self._free_increments("crossed", (u0, t0, u1, t1))
+
+    def _free_increments(self, method: str, arguments: tuple) -> tuple[np.ndarray, np.ndarray] | None:
+        dofs, increments = [], []
+        for term in self.terms:
+            ask = getattr(term, method, None)
+            found = None if ask is None else ask(*arguments)
+            if found is not None and len(found[0]):
+                dofs.append(np.asarray(found[0], dtype=np.int64))
+                increments.append(np.asarray(found[1], dtype=float))
+        if not dofs:
+            return None
+        dofs, increments = np.concatenate(dofs), np.concatenate(increments)
+        dofs, first = np.unique(dofs, return_index=True)
+        increments = increments[first]
+        keep = np.isin(dofs, self.pattern.free) & (increments != 0.0)
+        return (dofs[keep], increments[keep]) if np.any(keep) else None
+
     def check_state(self, u: np.ndarray, t: float) -> None:
         """Let every term vet an accepted state (:meth:`~skvalve.fem.terms.Term.check_state`)."""
         for term in self.terms:

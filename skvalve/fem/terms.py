@@ -111,6 +111,18 @@ class Term:
         (1: all of it). A contact barrier returns its collision-free step (continuous collision detection)."""
         return 1.0
 
+    def pushed(self, u: np.ndarray, t0: float, t1: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """``(dofs, increments)``: free dofs that the term's own prescribed motion from load factor ``t0`` to ``t1``
+        pushes at state ``u`` (a kinematic obstacle sweeping into vertices pressed on it), and how far; a start for
+        the step, not a constraint. ``None`` (the default): the term pushes nothing."""
+        return None
+
+    def crossed(self, u0: np.ndarray, t0: float, u1: np.ndarray, t1: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """``(dofs, increments)``: where the straight move from ``(u0, t0)`` to ``(u1, t1)`` is not collision-free,
+        the free dofs that are crossed and the increments (from ``u0``) that would let them ride with what crosses
+        them; ``None`` (the default) when the term sees no crossing."""
+        return None
+
     def check_state(self, u: np.ndarray, t: float) -> None:
         """Raise when ``u`` at load factor ``t`` is not an admissible accepted state (called by the solvers after
         each accepted state; a no-op unless a term checks something, e.g. intersections in a debug run)."""

@@ -69,6 +69,7 @@ from ..terms import Contribution, Term
 from .activation import CollisionPhase, CollisionPhases
 from .obstacles import Obstacle, Plane
 from .plane_barrier import PlaneBarrier
+from .push import crossing_followers, pushed_vertices
 from .surface import ContactSurface
 
 __all__ = ["IPCContact", "Friction", "IntersectionError", "barrier_pressure", "stiffness_for_pressure"]
@@ -357,6 +358,35 @@ class IPCContact(Term):
         if self._planes is not None:
             fraction = min(fraction, self._planes.step_fraction(V0, V1))
         return share if fraction >= 1.0 else max(STEP_SAFETY * share * fraction, SMALLEST_FRACTION)
+
+    def pushed(self, u: np.ndarray, t0: float, t1: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """The body's surface dofs that the obstacles in contact at ``t1`` push on their way from ``t0`` (the
+        surface at ``u``), with the motion of their closest obstacle points (:mod:`.push`; the first obstacle's
+        where two push one vertex)."""
+        V = self.positions(u, t0, phase_at=t1)
+        nodes, increments = [], []
+        for obstacle, rows in zip(self.obstacles, self._phase.slices, strict=True):
+            if rows is None:
+                continue
+            index, increment = pushed_vertices(V[: self.n_body], V[rows], obstacle.at(t1), obstacle.triangles,
+                                               self.dhat)
+            nodes.append(self.nodes[index])
+            increments.append(increment)
+        if not nodes or not sum(n.size for n in nodes):
+            return None
+        nodes, first = np.unique(np.concatenate(nodes), return_index=True)
+        dofs = (3 * nodes[:, None] + np.arange(3)).ravel()
+        return dofs, np.concatenate(increments)[first].ravel()
+
+    def crossed(self, u0: np.ndarray, t0: float, u1: np.ndarray, t1: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """The body's surface dofs on a side of a primitive pair (point-triangle, edge-edge) whose straight move from
+        ``(u0, t0)`` to ``(u1, t1)`` collides (ipctk's narrow-phase CCD), each with the mean motion of the other
+        side, which crosses it: an obstacle's side always, else the side that moves more (:mod:`.push`)."""
+        local, increments = crossing_followers(self.mesh, self.positions(u0, t0, phase_at=t1), self.positions(u1, t1),
+                                               self.n_body)
+        if local.size == 0:
+            return None
+        return (3 * self.nodes[local][:, None] + np.arange(3)).ravel(), increments.ravel()
 
     def intersects(self, u: np.ndarray, t: float) -> bool:
         """True when the collision mesh intersects itself at ``u``, ``t`` (ipctk ``has_intersections``) or a surface

@@ -134,6 +134,13 @@ class ObstacleTie(Term):
         return z
 
     # --------------------------------------------------------------------- term
+    def pushed(self, u: np.ndarray, t0: float, t1: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """The captured vertices ride with their points on the obstacles: :math:`z_v(t_1) - z_v(t_0)` (a step's
+        start, :meth:`~skvalve.fem.terms.Term.pushed`)."""
+        if self.vertex.size == 0:
+            return None
+        return self._dofs, (self.targets(t1) - self.targets(t0)).ravel()
+
     def energy(self, u: np.ndarray, t: float) -> float:
         if self.vertex.size == 0:
             return 0.0

@@ -21,6 +21,10 @@ a smooth interpolation that translates a region moved as a whole instead of shea
 graph is fixed, so :math:`L_{ff}` is factorised once. On the annuloplasty step above the extension (leaflet hexes
 and LINK bars) took the first residual from :math:`1.4\times 10^7` to :math:`4.2\times 10^3` load norms.
 :func:`~skvalve.fem.solvers.incremental.minimise_step` starts from it where the step's merit is lower there.
+
+Free dofs that a kinematic obstacle pushes (:mod:`skvalve.fem.contact.push`) join the prescribed ones for one call:
+their increments are given, and the extension solves the Laplace problem on the remaining free dofs (a factorisation
+of that block per call).
 """
 
 from __future__ import annotations
@@ -73,17 +77,32 @@ class MotionExtension:
         laplacian = (sp.diags(degree * (1.0 + REGULARISATION) + (degree == 0)) - adjacency).tocsr()
         pattern = problem.pattern
         self.fixed, self.free = pattern.fixed, pattern.free
+        self._laplacian = laplacian
+        self._name = linsolve.solver_name(solver)
         self._coupling = laplacian[self.free][:, self.fixed].tocsr()
-        self._solver = linsolve.LinearSolver(linsolve.solver_name(solver), symmetric=True)
-        matrix = laplacian[self.free][:, self.free].tocsr()
-        matrix.sort_indices()
-        self._solver.analyse(matrix).factorize(matrix)
+        self._solver = self._factorised(self.free)
 
-    def __call__(self, u_old: np.ndarray, u: np.ndarray) -> np.ndarray:
+    def _factorised(self, dofs: np.ndarray) -> linsolve.LinearSolver:
+        matrix = self._laplacian[dofs][:, dofs].tocsr()
+        matrix.sort_indices()
+        return linsolve.LinearSolver(self._name, symmetric=True).analyse(matrix).factorize(matrix)
+
+    def __call__(self, u_old: np.ndarray, u: np.ndarray,
+                 pushed: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
         """``u`` (prescribed dofs at their new values, free dofs as in ``u_old``) with the free dofs moved by the
-        extension of the prescribed increment ``u - u_old``."""
+        extension of the prescribed increment ``u - u_old``.
+
+        ``pushed``: ``(dofs, increments)`` of free dofs moved as if prescribed (an obstacle's push:
+        :meth:`~skvalve.fem.problem.Problem.pushed`); the extension then runs over the other free dofs, on a
+        factorisation of their own block of the Laplacian."""
         increment = np.asarray(u, dtype=float)[self.fixed] - np.asarray(u_old, dtype=float)[self.fixed]
         carried = np.array(u, dtype=float)
-        if np.any(increment):
+        if pushed is not None and len(pushed[0]):
+            dofs, moved = np.asarray(pushed[0], dtype=np.int64), np.asarray(pushed[1], dtype=float)
+            rest = np.setdiff1d(self.free, dofs, assume_unique=True)
+            carried[dofs] = np.asarray(u_old, dtype=float)[dofs] + moved
+            rhs = self._laplacian[rest][:, self.fixed] @ increment + self._laplacian[rest][:, dofs] @ moved
+            carried[rest] += self._factorised(rest).solve(-rhs)
+        elif np.any(increment):
             carried[self.free] += self._solver.solve(-(self._coupling @ increment))
         return carried

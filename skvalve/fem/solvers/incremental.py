@@ -236,9 +236,12 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
     been held to 0.07-0.25 of their length for 28 iterations at a residual of 0.2-0.3 load norms (52 in all); with
     the relaxed trials the step took 34.
 
-    ``carry``: a :class:`~skvalve.fem.solvers.extension.MotionExtension` (``carry(u_old, u)``): the step starts from
-    the prescribed increment's harmonic extension where its merit is lower than with the prescribed dofs moved alone
-    and its motion from ``u_old`` is collision-free."""
+    ``carry``: a :class:`~skvalve.fem.solvers.extension.MotionExtension` (``carry(u_old, u, pushed)``): the step
+    starts from the prescribed increment's harmonic extension where its merit is lower than with the prescribed dofs
+    moved alone and its motion from ``u_old`` is collision-free. The free dofs a term's prescribed motion pushes
+    (:meth:`~skvalve.fem.problem.Problem.pushed`: kinematic obstacles moving towards vertices within reach of them,
+    :mod:`skvalve.fem.contact.push`) move with it, and the extension carries the rest; where that start is still not
+    collision-free, the dofs it crosses ride with what crosses them (:func:`~.step_start.carried_start`)."""
     pattern = problem.pattern
     fixed, free = pattern.fixed, pattern.free
     u = u_old.copy()
@@ -249,10 +252,13 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
     work = problem.work_terms(u_old, t_new)
     energy_merit = not work
     moved = bool(fixed.size and np.any(u[fixed] != u_old[fixed]))
-    collision_free = problem.step_fraction(u_old, t_old, u, t_new) >= 1.0
-    if moved and carry is not None:
-        u, collision_free = carried_start(problem, u_old, t_old, u, collision_free, t_new, carry(u_old, u), predictor,
-                                          inertia, step, energy_merit)
+    # vertices pressed on an obstacle that moves towards them: its motion alone would cross them (and ipctk's CCD of
+    # such a crossing is slow: 32 s for a 2 x 2 x 2 block on a plate rising through it), so they ride with it
+    pushed = problem.pushed(u_old, t_old, t_new) if carry is not None else None
+    collision_free = pushed is None and problem.step_fraction(u_old, t_old, u, t_new) >= 1.0
+    if carry is not None and (moved or not collision_free):
+        u, collision_free = carried_start(problem, u_old, t_old, u, collision_free, t_new, partial(carry, u_old, u),
+                                          pushed, predictor, inertia, step, energy_merit)
     if not collision_free:
         raise StepFailed(f"the prescribed motion from load factor {t_old:.6g} to {t_new:.6g} is not collision-free "
                          "(or moves a surface vertex farther than one CCD sweep reaches)")

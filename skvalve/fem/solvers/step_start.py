@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Callable
 
 import numpy as np
 import scipy.sparse as sp
@@ -26,6 +27,9 @@ from .trust_steps import projected_tangent
 __all__ = ["carried_start", "consistent_predictor", "step_merit"]
 
 logger = logging.getLogger("skvalve.fem")
+
+#: how many times a carried start that is not collision-free lets the dofs it crosses ride along before giving up
+PUSH_ROUNDS = 6
 
 
 def consistent_predictor(problem: Problem, u_old: np.ndarray, u: np.ndarray, t_new: float, predictor: np.ndarray,
@@ -68,12 +72,26 @@ def step_merit(problem: Problem, state: np.ndarray, t: float, predictor: np.ndar
 
 
 def carried_start(problem: Problem, u_old: np.ndarray, t_old: float, u: np.ndarray, alone_free: bool, t_new: float,
-                  carried: np.ndarray, predictor: np.ndarray, inertia: np.ndarray, step: int,
-                  energy_merit: bool) -> tuple[np.ndarray, bool]:
-    """``(start, collision_free)``: ``carried`` (the free dofs moved by the prescribed increment's extension) where its
-    motion from ``u_old`` is collision-free and either the move to ``u`` (the prescribed dofs moved alone; its CCD
-    verdict ``alone_free``) is not or the step's merit is lower at ``carried``; else ``u`` and ``alone_free``."""
-    if np.array_equal(carried, u) or problem.step_fraction(u_old, t_old, carried, t_new) < 1.0:
+                  extend: Callable, pushed: tuple[np.ndarray, np.ndarray] | None, predictor: np.ndarray,
+                  inertia: np.ndarray, step: int, energy_merit: bool) -> tuple[np.ndarray, bool]:
+    """``(start, collision_free)``: the carried state ``extend(pushed)`` (the free dofs moved by the prescribed
+    increment's extension, ``pushed`` dofs moved as given) where its motion from ``u_old`` is collision-free and
+    either the move to ``u`` (the prescribed dofs moved alone; its CCD verdict ``alone_free``) is not or the step's
+    merit is lower at the carried state; else ``u`` and ``alone_free``.
+
+    Where the carried motion is not collision-free, the free dofs it crosses ride with what crosses them
+    (:meth:`~skvalve.fem.problem.Problem.crossed`), and the extension is taken again, up to ``PUSH_ROUNDS`` times."""
+    carried = extend(pushed)
+    rounds = 0
+    while problem.step_fraction(u_old, t_old, carried, t_new) < 1.0:
+        more = problem.crossed(u_old, t_old, carried, t_new) if rounds < PUSH_ROUNDS else None
+        if more is None:
+            return u, alone_free
+        pushed = more if pushed is None else _merged(pushed, more)
+        carried = extend(pushed)
+        rounds += 1
+        logger.debug("step %d: push round %d, %d dofs ride with what crosses them", step, rounds, more[0].size)
+    if np.array_equal(carried, u):
         return u, alone_free
     if not alone_free:
         logger.debug("step %d: carried (the prescribed dofs moved alone are not collision-free)", step)
@@ -81,3 +99,10 @@ def carried_start(problem: Problem, u_old: np.ndarray, t_old: float, u: np.ndarr
     merits = [step_merit(problem, state, t_new, predictor, inertia, step, energy_merit) for state in (u, carried)]
     logger.debug("step %d: merit %.3e with the prescribed dofs moved alone, %.3e carried", step, *merits)
     return (carried if merits[1] < merits[0] else u), True
+
+
+def _merged(pushed: tuple[np.ndarray, np.ndarray], more: tuple[np.ndarray, np.ndarray]
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """The union of two ``(dofs, increments)`` sets, ``more``'s increment where both hold a dof."""
+    keep = ~np.isin(pushed[0], more[0])
+    return np.concatenate([pushed[0][keep], more[0]]), np.concatenate([pushed[1][keep], more[1]])
