@@ -53,8 +53,13 @@ def _leaflet(side: float, width: float, height: float, thickness: float, gap: fl
 
 
 def write_mini_valve(path: str | Path, pressure: float = 0.004, pull: float = 0.5, width: float = 8.0,
-                     height: float = 6.0, thickness: float = 0.4, gap: float = 4.0, nw: int = 4, nh: int = 3) -> Path:
-    """Write the deck (module docstring) to ``path`` and return it. Lengths in mm, pressure in MPa."""
+                     height: float = 6.0, thickness: float = 0.4, gap: float = 4.0, nw: int = 4, nh: int = 3,
+                     arm: float | None = None) -> Path:
+    """Write the deck (module docstring) to ``path`` and return it. Lengths in mm, pressure in MPa.
+
+    ``arm``: a second step (0.5 of step time) in which a rigid R3D4 plate, hinged 0.5 mm outside leaflet A's outer
+    face at the annulus, turns by ``arm`` rad about the y-axis (smooth step) and sweeps into that leaflet, as the
+    clip input's arms do."""
     nodes, elements, lines = [], [], []
     leaflets = []
     for name, side in (("A", 1.0), ("B", -1.0)):
@@ -104,6 +109,15 @@ def write_mini_valve(path: str | Path, pressure: float = 0.004, pull: float = 0.
     lines += ["*Assembly, name=Assembly", "*Instance, name=Leaflet_Instance, part=Leaflet", "*End Instance"]
     lines.append("*Surface, type=ELEMENT, name=Leaflet_Surfaces_Outer")
     lines += [f"Leaflet_Instance.{name}_Outer, {outer}" for name, _s, _b, outer, _a, _f in leaflets]
+    hinge = np.array([0.5 * gap + thickness + 0.5, 0.5 * width, 0.0])
+    if arm is not None:  # a 4 x 6.5 mm plate below the hinge; its reference node on the hinge, turning about y
+        corners = hinge + np.array([[0.0, -2.0, -1.0], [0.0, 2.0, -1.0], [0.0, 2.0, -7.5], [0.0, -2.0, -7.5]])
+        first = len(nodes) + 1
+        lines += ["*Node"] + [f"{first + k}, {x:.9g}, {y:.9g}, {z:.9g}" for k, (x, y, z) in enumerate(corners)]
+        lines += [f"{first + 4}, {hinge[0]:.9g}, {hinge[1]:.9g}, {hinge[2]:.9g}",
+                  "*Element, type=R3D4, elset=Arm", f"{label + 1}, {first}, {first + 1}, {first + 2}, {first + 3}",
+                  "*Nset, nset=Arm_RP", f"{first + 4}", "*Rigid Body, ref node=Arm_RP, elset=Arm",
+                  "*Transform, nset=Arm_RP", "0., 0., 1., 1., 0., 0."]  # local 3-axis: z x x = y
     lines.append("*End Assembly")
     lines += ["*Amplitude, name=Amp-1, definition=SMOOTH STEP", "0.5, 0., 1.5, 1.",
               "*Amplitude, name=Amp-2, definition=SMOOTH STEP", "0., 0., 0.5, 1."]
@@ -122,7 +136,13 @@ def write_mini_valve(path: str | Path, pressure: float = 0.004, pull: float = 0.
         lines.append("*Boundary, op=NEW, amplitude=Amp-2")
         lines += [f"Leaflet_Instance.{tip + 1}, 1, 1, 0.0", f"Leaflet_Instance.{tip + 1}, 2, 2, 0.0",
                   f"Leaflet_Instance.{tip + 1}, 3, 3, {-pull:.9g}"]
-    lines += ["*Dsload, op=NEW, amplitude=Amp-1", f"Leaflet_Surfaces_Outer, P, {pressure:.9g}", "*End Step", ""]
+    if arm is not None:
+        lines += ["*Boundary", "Arm_RP, 1, 5", "*Boundary", "Arm_RP, 6, 6, 0."]
+    lines += ["*Dsload, op=NEW, amplitude=Amp-1", f"Leaflet_Surfaces_Outer, P, {pressure:.9g}", "*End Step"]
+    if arm is not None:
+        lines += ["*Step, name=Clip, nlgeom=YES", "*Dynamic, Explicit", ", 0.5", "*Boundary, amplitude=Amp-2",
+                  f"Arm_RP, 6, 6, {arm:.9g}", "*End Step"]
+    lines.append("")
     path = Path(path)
     path.write_text("\n".join(lines))
     return path
