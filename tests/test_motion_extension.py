@@ -100,3 +100,20 @@ def test_a_prescribed_move_that_crosses_the_body_alone_is_carried():
     u, _, _ = minimise_step(solid, u_old, 0.0, 1.0, u_old, np.zeros_like(u_old), 1, options, solver, carry=extension)
     np.testing.assert_allclose(u.reshape(-1, 3), np.tile([0.0, 0.0, -0.8], (u.size // 3, 1)), atol=1e-9)
     assert not contact.intersects(u, 1.0)
+
+
+def test_a_pushed_node_moves_the_elements_around_it_as_a_whole():
+    """A node in the slab's middle pushed by (0, 0, 0.2) with nothing prescribed moving: every node of the hexes
+    around it moves by exactly that (the elements ride whole: none is crushed), the others by less, and the held
+    x = 0 face not at all."""
+    solid = _slab([0.0, 0.0, 0.0])
+    extension = MotionExtension(solid, solid.terms)
+    X = solid.mesh.p
+    node = int(np.argmin(np.linalg.norm(X.T - [0.5, 0.5, 0.1], axis=1)))
+    u0 = np.zeros(solid.space.n_dofs)
+    carried = extension(u0, u0, (np.array([3 * node + 2]), np.array([0.2]))).reshape(-1, 3)
+    around = np.unique(solid.mesh.t[:, np.any(solid.mesh.t == node, axis=0)])
+    np.testing.assert_allclose(carried[around], np.tile([0.0, 0.0, 0.2], (around.size, 1)), atol=1e-15)
+    others = np.setdiff1d(np.arange(X.shape[1]), around)
+    assert np.all(carried[others, 2] < 0.2) and np.all(carried[X[0] < 1e-9, 2] == 0.0)
+    np.testing.assert_allclose(carried[:, :2], 0.0, atol=0.0)
