@@ -53,6 +53,7 @@ def closest_points_on_triangles(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: 
     d3, d4 = _dot(ab, p - b), _dot(ac, p - b)
     d5, d6 = _dot(ab, p - c), _dot(ac, p - c)
     va, vb, vc = d3 * d6 - d5 * d4, d5 * d2 - d1 * d6, d1 * d4 - d3 * d2  # sub-areas opposite a, b, c (scaled)
+
     def ratio(num: np.ndarray, den: np.ndarray) -> np.ndarray:
         safe = np.where(den != 0.0, den, 1.0)
         return np.clip(np.where(den != 0.0, num / safe, 0.0), 0.0, 1.0)
