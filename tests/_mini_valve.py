@@ -6,6 +6,9 @@ pushes them together; each leaflet's free edge hangs on two chordae (two-bar cha
 papillary tip, pulled down by ``pull`` over 0-0.5 of step time), with the Ogden law in uniaxial stress. The deck
 is written, not computed: the closure reads it as it reads the shipped inputs.
 
+With ``arm``, a second step turns a rigid R3D4 plate into leaflet A (the clip input's keywords: ``*Rigid Body``,
+``*Transform``, the reference node's dof 6), for ``tests/test_valve_close_mini_clip.py``.
+
 By construction the model is symmetric about x = 0 (the two leaflets) and about y = width/2 (each leaflet), and
 its reactions balance the pressure: the checks of ``tests/test_valve_close_mini.py``.
 """
@@ -109,8 +112,8 @@ def write_mini_valve(path: str | Path, pressure: float = 0.004, pull: float = 0.
     lines += ["*Assembly, name=Assembly", "*Instance, name=Leaflet_Instance, part=Leaflet", "*End Instance"]
     lines.append("*Surface, type=ELEMENT, name=Leaflet_Surfaces_Outer")
     lines += [f"Leaflet_Instance.{name}_Outer, {outer}" for name, _s, _b, outer, _a, _f in leaflets]
-    hinge = np.array([0.5 * gap + thickness + 0.5, 0.5 * width, 0.0])
     if arm is not None:  # a 4 x 6.5 mm plate below the hinge; its reference node on the hinge, turning about y
+        hinge = np.array([0.5 * gap + thickness + 0.5, 0.5 * width, 0.0])
         corners = hinge + np.array([[0.0, -2.0, -1.0], [0.0, 2.0, -1.0], [0.0, 2.0, -7.5], [0.0, -2.0, -7.5]])
         first = len(nodes) + 1
         lines += ["*Node"] + [f"{first + k}, {x:.9g}, {y:.9g}, {z:.9g}" for k, (x, y, z) in enumerate(corners)]

@@ -1,6 +1,7 @@
 """A moving obstacle pushes the vertices pressed on it (:mod:`skvalve.fem.contact.push`): closest points checked against
-ipctk's point-triangle distance, the pushed set against its closed form, and a step whose obstacle sweeps into a
-pressed block against the same equilibrium reached by steps short enough to need no push."""
+ipctk's point-triangle distance, the pushed set and the crossing followers against their closed forms, and steps
+whose obstacle sweeps into a pressed block (a plate; a spike that crosses a face no node faces) against the same
+equilibrium reached by steps short enough to need no push."""
 
 import logging
 
