@@ -14,6 +14,7 @@ from skvalve.fem.meshes import box
 from skvalve.fem.solvers import linsolve
 from skvalve.fem.solvers.extension import MotionExtension
 from skvalve.fem.solvers.incremental import IncrementalOptions, StepFailed, minimise_step
+from skvalve.fem.terms import Contribution, Term
 from skvalve.materials import NeoHookean
 
 MATERIAL = NeoHookean.from_shear_poisson(1.0, 0.3)
@@ -117,3 +118,26 @@ def test_a_pushed_node_moves_the_elements_around_it_as_a_whole():
     others = np.setdiff1d(np.arange(X.shape[1]), around)
     assert np.all(carried[others, 2] < 0.2) and np.all(carried[X[0] < 1e-9, 2] == 0.0)
     np.testing.assert_allclose(carried[:, :2], 0.0, atol=0.0)
+
+
+def test_a_carried_start_that_a_term_limits_is_refused_naming_the_term():
+    """A term that allows half of any move (a stand-in for the corner barrier): the carried start of a prescribed
+    shear is refused, and the step's failure names that term and its share."""
+
+    class Halving(Term):
+        name = "halving stand-in"
+
+        def assemble(self, u, t, tangent, step):
+            return Contribution(internal=np.zeros(u.size))
+
+        def step_fraction(self, u0, t0, u1, t1):
+            return 0.5 if np.any(u1 != u0) else 1.0
+
+    solid = _slab([0.0, 0.3, 0.0])
+    solid.add_term(Halving())
+    u_old = np.zeros(solid.space.n_dofs)
+    options = IncrementalOptions(rtol=1e-10, atol=1e-12, predictor=False)
+    with pytest.raises(StepFailed, match="the carried start is limited by halving stand-in 0.5"):
+        minimise_step(solid, u_old, 0.0, 1.0, u_old, np.zeros_like(u_old), 1, options, linsolve.solver_name(None),
+                      carry=MotionExtension(solid, solid.terms[:1]))
+    assert solid.step_limits(u_old, 0.0, u_old, 1.0) == ""

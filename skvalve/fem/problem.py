@@ -289,6 +289,13 @@ class Problem:
                 fraction = min(fraction, value)
         return fraction
 
+    def step_limits(self, u0: np.ndarray, t0: float, u1: np.ndarray, t1: float) -> str:
+        """The terms that allow less than the whole straight move from ``(u0, t0)`` to ``(u1, t1)``, with their shares
+        (``"corner barrier 0.464, ipc contact 0.26"``; empty when none limits it): what a refused step names."""
+        limits = [(term.name, float(term.step_fraction(u0, t0, u1, t1))) for term in self.terms
+                  if getattr(term, "step_fraction", None) is not None]
+        return ", ".join(f"{name} {share:.3g}" for name, share in limits if share < 1.0)
+
     def pushed(self, u: np.ndarray, t0: float, t1: float) -> tuple[np.ndarray, np.ndarray] | None:
         """The free dofs the terms' prescribed motion pushes from ``t0`` to ``t1`` at ``u``, with their nonzero
         increments (:meth:`~skvalve.fem.terms.Term.pushed`; a dof two terms push takes the first one's); ``None`` when

@@ -256,12 +256,15 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
     # such a crossing is slow: 32 s for a 2 x 2 x 2 block on a plate rising through it), so they ride with it
     pushed = problem.pushed(u_old, t_old, t_new) if carry is not None else None
     collision_free = pushed is None and problem.step_fraction(u_old, t_old, u, t_new) >= 1.0
+    limits = ""
     if carry is not None and (moved or not collision_free):
-        u, collision_free = carried_start(problem, u_old, t_old, u, collision_free, t_new, partial(carry, u_old, u),
-                                          pushed, predictor, inertia, step, energy_merit)
+        u, collision_free, limits = carried_start(problem, u_old, t_old, u, collision_free, t_new,
+                                                  partial(carry, u_old, u), pushed, predictor, inertia, step,
+                                                  energy_merit)
     if not collision_free:
+        carried = f"; the carried start is limited by {limits}" if limits else ""
         raise StepFailed(f"the prescribed motion from load factor {t_old:.6g} to {t_new:.6g} is not collision-free "
-                         "(or moves a surface vertex farther than one CCD sweep reaches)")
+                         f"(or moves a surface vertex farther than one CCD sweep reaches){carried}")
     if opts.predictor and moved:
         u = consistent_predictor(problem, u_old, u, t_new, predictor, inertia, step, solver, energy_merit)
     if relax is not None:

@@ -73,11 +73,13 @@ def step_merit(problem: Problem, state: np.ndarray, t: float, predictor: np.ndar
 
 def carried_start(problem: Problem, u_old: np.ndarray, t_old: float, u: np.ndarray, alone_free: bool, t_new: float,
                   extend: Callable, pushed: tuple[np.ndarray, np.ndarray] | None, predictor: np.ndarray,
-                  inertia: np.ndarray, step: int, energy_merit: bool) -> tuple[np.ndarray, bool]:
-    """``(start, collision_free)``: the carried state ``extend(pushed)`` (the free dofs moved by the prescribed
+                  inertia: np.ndarray, step: int, energy_merit: bool) -> tuple[np.ndarray, bool, str]:
+    """``(start, collision_free, limits)``: the carried state ``extend(pushed)`` (the free dofs moved by the prescribed
     increment's extension, ``pushed`` dofs moved as given) where its motion from ``u_old`` is collision-free and
     either the move to ``u`` (the prescribed dofs moved alone; its CCD verdict ``alone_free``) is not or the step's
-    merit is lower at the carried state; else ``u`` and ``alone_free``.
+    merit is lower at the carried state; else ``u`` and ``alone_free``. ``limits``: the terms that allow less than
+    the whole move to the last carried state tried (:meth:`~skvalve.fem.problem.Problem.step_limits`) where it was
+    refused, else empty.
 
     Where the carried motion is not collision-free, the free dofs it crosses ride with what crosses them
     (:meth:`~skvalve.fem.problem.Problem.crossed`), and the extension is taken again, up to ``PUSH_ROUNDS`` times."""
@@ -86,19 +88,19 @@ def carried_start(problem: Problem, u_old: np.ndarray, t_old: float, u: np.ndarr
     while problem.step_fraction(u_old, t_old, carried, t_new) < 1.0:
         more = problem.crossed(u_old, t_old, carried, t_new) if rounds < PUSH_ROUNDS else None
         if more is None:
-            return u, alone_free
+            return u, alone_free, problem.step_limits(u_old, t_old, carried, t_new)
         pushed = more if pushed is None else _merged(pushed, more)
         carried = extend(pushed)
         rounds += 1
         logger.debug("step %d: push round %d, %d dofs ride with what crosses them", step, rounds, more[0].size)
     if np.array_equal(carried, u):
-        return u, alone_free
+        return u, alone_free, ""
     if not alone_free:
         logger.debug("step %d: carried (the prescribed dofs moved alone are not collision-free)", step)
-        return carried, True
+        return carried, True, ""
     merits = [step_merit(problem, state, t_new, predictor, inertia, step, energy_merit) for state in (u, carried)]
     logger.debug("step %d: merit %.3e with the prescribed dofs moved alone, %.3e carried", step, *merits)
-    return (carried if merits[1] < merits[0] else u), True
+    return (carried if merits[1] < merits[0] else u), True, ""
 
 
 def _merged(pushed: tuple[np.ndarray, np.ndarray], more: tuple[np.ndarray, np.ndarray]
