@@ -279,22 +279,24 @@ class Problem:
     def step_fraction(self, u0: np.ndarray, t0: float, u1: np.ndarray, t1: float) -> float:
         """The smallest of the terms' :meth:`~skvalve.fem.terms.Term.step_fraction` for the straight move from
         ``(u0, t0)`` to ``(u1, t1)``: the share of it that every term allows (1 when none limits steps)."""
-        fraction = 1.0
+        return min((share for _, share in self._step_shares(u0, t0, u1, t1)), default=1.0)
+
+    def step_limits(self, u0: np.ndarray, t0: float, u1: np.ndarray, t1: float) -> str:
+        """The terms that allow less than the whole straight move from ``(u0, t0)`` to ``(u1, t1)``, with their shares
+        (``"corner barrier 0.464, ipc contact 0.26"``; empty when none limits it): what a refused step names."""
+        return ", ".join(f"{name} {share:.3g}" for name, share in self._step_shares(u0, t0, u1, t1) if share < 1.0)
+
+    def _step_shares(self, u0: np.ndarray, t0: float, u1: np.ndarray, t1: float) -> list[tuple[str, float]]:
+        """Each term's name and :meth:`~skvalve.fem.terms.Term.step_fraction` of the move (checked to lie in (0, 1])."""
+        shares = []
         for term in self.terms:
             limit = getattr(term, "step_fraction", None)
             if limit is not None:
                 value = float(limit(u0, t0, u1, t1))
                 if not 0.0 < value <= 1.0:
                     raise ValueError(f"term {term.name!r}: step_fraction must lie in (0, 1]; got {value!r}")
-                fraction = min(fraction, value)
-        return fraction
-
-    def step_limits(self, u0: np.ndarray, t0: float, u1: np.ndarray, t1: float) -> str:
-        """The terms that allow less than the whole straight move from ``(u0, t0)`` to ``(u1, t1)``, with their shares
-        (``"corner barrier 0.464, ipc contact 0.26"``; empty when none limits it): what a refused step names."""
-        limits = [(term.name, float(term.step_fraction(u0, t0, u1, t1))) for term in self.terms
-                  if getattr(term, "step_fraction", None) is not None]
-        return ", ".join(f"{name} {share:.3g}" for name, share in limits if share < 1.0)
+                shares.append((getattr(term, "name", type(term).__name__), value))
+        return shares
 
     def pushed(self, u: np.ndarray, t0: float, t1: float) -> tuple[np.ndarray, np.ndarray] | None:
         """The free dofs the terms' prescribed motion pushes from ``t0`` to ``t1`` at ``u``, with their nonzero

@@ -126,6 +126,11 @@ def stiffness_for_pressure(pressure: float, dhat: float, at: float = 0.5) -> flo
     return float(pressure / barrier_pressure(at * dhat, dhat, 1.0))
 
 
+def _dofs_of(nodes: np.ndarray) -> np.ndarray:
+    """The displacement dofs (node-major, three per node) of scalar nodes ``nodes``."""
+    return (3 * np.asarray(nodes, dtype=np.int64)[:, None] + np.arange(3)).ravel()
+
+
 class IPCContact(Term):
     r"""IPC barrier contact of a body's surface with itself, with moving obstacles and with planes.
 
@@ -197,7 +202,7 @@ class IPCContact(Term):
         self.collisions = ipctk.NormalCollisions()
         self.collisions.use_area_weighting = True
         self._built_for: tuple[tuple[bool, ...], np.ndarray] | None = None
-        rows = (3 * self.nodes[:, None] + np.arange(3)).ravel()
+        rows = _dofs_of(self.nodes)
         select = sp.csr_matrix((np.ones(rows.size), (rows, np.arange(rows.size))),
                                shape=(space.n_dofs, 3 * self.rest.shape[0]))
         self._phases = CollisionPhases(self.rest, self.n_body, local[surface.triangles], self.obstacles,
@@ -375,8 +380,7 @@ class IPCContact(Term):
         if not nodes or not sum(n.size for n in nodes):
             return None
         nodes, first = np.unique(np.concatenate(nodes), return_index=True)
-        dofs = (3 * nodes[:, None] + np.arange(3)).ravel()
-        return dofs, np.concatenate(increments)[first].ravel()
+        return _dofs_of(nodes), np.concatenate(increments)[first].ravel()
 
     def crossed(self, u0: np.ndarray, t0: float, u1: np.ndarray, t1: float) -> tuple[np.ndarray, np.ndarray] | None:
         """The body's surface dofs on a side of a primitive pair (point-triangle, edge-edge) whose straight move from
@@ -386,7 +390,7 @@ class IPCContact(Term):
                                                self.n_body)
         if local.size == 0:
             return None
-        return (3 * self.nodes[local][:, None] + np.arange(3)).ravel(), increments.ravel()
+        return _dofs_of(self.nodes[local]), increments.ravel()
 
     def intersects(self, u: np.ndarray, t: float) -> bool:
         """True when the collision mesh intersects itself at ``u``, ``t`` (ipctk ``has_intersections``) or a surface

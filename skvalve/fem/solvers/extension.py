@@ -115,7 +115,8 @@ class MotionExtension:
             dofs, moved = self._with_elements(np.asarray(pushed[0], dtype=np.int64), np.asarray(pushed[1], dtype=float))
             rest = np.setdiff1d(self.free, dofs, assume_unique=True)
             carried[dofs] = np.asarray(u_old, dtype=float)[dofs] + moved
-            rhs = self._laplacian[rest][:, self.fixed] @ increment + self._laplacian[rest][:, dofs] @ moved
+            rows = self._laplacian[rest]
+            rhs = rows[:, self.fixed] @ increment + rows[:, dofs] @ moved
             carried[rest] += self._factorised(rest).solve(-rhs)
         elif np.any(increment):
             carried[self.free] += self._solver.solve(-(self._coupling @ increment))
