@@ -79,6 +79,32 @@ def test_step_fraction_stops_before_the_corner_flattens():
     assert barrier.step_fraction(np.zeros(space.n_dofs), 0.0, 0.3 * move, 0.0) == 1.0
 
 
+def test_crossed_moves_the_folding_hexes_rigidly_and_that_move_is_admissible():
+    """Two hexes side by side; the move pushes the first one's outer top edge through its bottom. ``crossed`` names that
+    hex's 8 nodes with its mean increment (a translation: every corner ratio unchanged, so the barrier allows the whole
+    move), the second hex's own nodes not at all; a move that folds nothing gives None."""
+    mesh = skfem.MeshHex.init_tensor(np.array([0.0, 1.0, 2.0]), np.array([0.0, 1.0]), np.array([0.0, 1.0]))
+    space = Space(mesh)
+    barrier = CornerBarrier(space, 1.0)
+    u0 = np.zeros(space.n_dofs)
+    first = mesh.t[:, 0]
+    edge = first[(mesh.p[2, first] > 0.5) & (mesh.p[0, first] < 0.5)]  # not shared with the second hex
+    move = np.zeros(space.n_dofs)
+    move.reshape(-1, 3)[edge, 2] = -2.0  # 1 below the bottom
+    move.reshape(-1, 3)[:, 0] += 0.25  # and everything slid along x
+    assert barrier.step_fraction(u0, 0.0, move, 0.0) < 1.0
+    dofs, increments = barrier.crossed(u0, 0.0, move, 0.0)
+    nodes = np.unique(dofs // 3)
+    assert sorted(nodes.tolist()) == sorted(first.tolist())
+    mean = move.reshape(-1, 3)[first].mean(axis=0)
+    assert np.allclose(increments.reshape(-1, 3), mean, rtol=0.0, atol=1e-15)
+    assert np.allclose(mean, [0.25, 0.0, -0.5])
+    rigid = move.copy()
+    rigid[dofs] = increments
+    assert np.allclose(barrier.ratios(rigid)[:8], 1.0, rtol=0.0, atol=1e-14)
+    assert barrier.crossed(u0, 0.0, 0.3 * move, 0.0) is None
+
+
 def test_first_root_of_a_cubic_that_dips_below_zero_and_comes_back():
     """J(a) = k (a - 0.3)(a - 0.6)(a - 2) is positive at 0 and at 1 but not between 0.3 and 0.6."""
     k = -1.0 / 0.36

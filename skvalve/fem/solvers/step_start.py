@@ -81,8 +81,10 @@ def carried_start(problem: Problem, u_old: np.ndarray, t_old: float, u: np.ndarr
     the whole move to the last carried state tried (:meth:`~skvalve.fem.problem.Problem.step_limits`) where it was
     refused, else empty.
 
-    Where the carried motion is not collision-free, the free dofs it crosses ride with what crosses them
-    (:meth:`~skvalve.fem.problem.Problem.crossed`), and the extension is taken again, up to ``PUSH_ROUNDS`` times."""
+    Where a term allows less than the whole carried motion, the free dofs it names ride as it says
+    (:meth:`~skvalve.fem.problem.Problem.crossed`: those a collision crosses with what crosses them, the hexes that
+    would fold a corner translated by their mean motion), and the extension is taken again, up to ``PUSH_ROUNDS``
+    times."""
     carried = extend(pushed)
     rounds = 0
     while problem.step_fraction(u_old, t_old, carried, t_new) < 1.0:
