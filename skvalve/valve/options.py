@@ -174,10 +174,12 @@ class HoldOptions:
        coaptation forms;
     3. *proximal*: the path's steps with the load held, each a proximal step with the pseudo-mass :math:`c/h`
        (``StepOptions.damping`` over a pseudo-step :math:`h`) starting at the path's last step length and growing
-       ``growth``-fold after each step of at most ``StepOptions.easy_iterations`` iterations (halved after a failed
-       one), each solved to a tenth of the static residual it starts from, to ``rtol`` of the undamped problem. A
-       step whose iterations run out is taken at its last iterate when that lowers the static residual (an inexact
-       proximal step; the pseudo-step stays as it was).
+       ``growth``-fold after each step of at most ``StepOptions.easy_iterations`` iterations, else by the ratio of
+       the static residuals before and after the step (switched evolution relaxation, at most ``growth``;
+       :func:`~skvalve.valve.run.proximal_growth`) and halved after a failed step, each solved to a tenth of the
+       static residual it starts from, to ``rtol`` of the undamped problem. A step whose iterations run out is taken
+       at its last iterate when that lowers the static residual (an inexact proximal step; the pseudo-step stays as
+       it was).
 
     An energy stage hands on below ``proximal_below`` or when its energy drop stalls (the last 20 steps' average
     below ``stall_fraction`` of the stage's). Why proximal steps at the end: a follower pressure on the leaflets'

@@ -46,7 +46,8 @@ from . import linsolve
 from .newton import reference_force
 from .ptc_options import PseudoTransientOptions
 
-__all__ = ["PseudoTransientOptions", "PseudoTransientStep", "PseudoTransientResult", "pseudo_transient"]
+__all__ = ["PseudoTransientOptions", "PseudoTransientStep", "PseudoTransientResult", "pseudo_transient",
+           "switched_evolution_factor"]
 
 logger = logging.getLogger("skvalve.fem")
 
@@ -103,6 +104,14 @@ class _Rejected(Exception):
     def __init__(self, message: str, factor: float = 0.25, nodes: np.ndarray | None = None) -> None:
         super().__init__(message)
         self.factor, self.nodes = factor, nodes
+
+
+def switched_evolution_factor(previous: float, current: float, growth: float, held: float = 1.0) -> float:
+    r"""Switched evolution relaxation's pseudo-step factor (Mulder & Van Leer 1985, *J. Comput. Phys.* 59:232):
+    :math:`\lVert R_{k-1}\rVert/\lVert R_k\rVert`, at least ``held`` while the residual does not grow and at least
+    1/2 when it does, at most ``growth``: the pseudo-step grows as the residual falls, so :math:`\Delta\tau\,\lVert
+    R\rVert` stays about constant and the damping fades into Newton's steps near the equilibrium."""
+    return min(growth, max(previous / max(current, 1e-300), held if current <= previous else 0.5))
 
 
 def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options: PseudoTransientOptions | None = None,
@@ -230,8 +239,7 @@ def pseudo_transient(problem: Problem, weights: np.ndarray, end: float, options:
             if t < end:  # following the load: grow back towards the load path's resolution after cuts
                 dtau = min(dtau * opts.load_growth, opts.max_load_step)
             else:  # switched evolution relaxation
-                dtau *= min(opts.growth, max(previous / max(norm, 1e-300), opts.held_growth if norm <= previous
-                                             else 0.5))
+                dtau *= switched_evolution_factor(previous, norm, opts.growth, opts.held_growth)
             if opts.fill is not None and used > 0.0:  # aim the next step at a share of the trust regions
                 dtau = min(dtau, dtau_taken * opts.fill / used)
             failure = None
