@@ -140,5 +140,27 @@ def test_a_crossed_triangle_rides_with_the_vertex_that_crosses_it():
     mesh = ipctk.CollisionMesh(V0, ipctk.edges(faces[:1]), faces[:1])
     V1 = V0 + np.r_[np.tile([0.0, 0.0, 0.1], (3, 1)), np.zeros((1, 3))]
     vertices, increments = crossing_followers(mesh, V0, V1, n_body=4)
-    assert vertices.tolist() == [3]
-    np.testing.assert_allclose(increments, [[0.0, 0.0, 0.1]], atol=1e-15)
+    assert vertices.tolist() == [0, 1, 2, 3]  # the triangle keeps its motion, the point rides with it
+    np.testing.assert_allclose(increments, [[0.0, 0.0, 0.1]] * 4, atol=1e-15)
+
+
+def test_a_crossed_edge_rides_with_the_motion_of_its_closest_point_on_a_turning_edge():
+    """A body edge along x lifts and turns (its ends rise 0.1 and 0.3) under a crossing edge 0.01 above it at
+    x = 0.9. The crossed edge rides with the motion of its closest points on the turning edge (0.28 at x = 0.9), and
+    moved so the step is collision-free; with the turning edge's mean motion (0.2) it would still be crossed."""
+    V0 = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.9, -0.5, 0.01], [0.9, 0.5, 0.01]])
+    edges = np.array([[0, 1], [2, 3]])
+    mesh = ipctk.CollisionMesh(V0, edges, np.zeros((0, 3), dtype=np.int64))
+    V1 = V0 + np.array([[0.0, 0.0, 0.1], [0.0, 0.0, 0.3], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    assert not ipctk.is_step_collision_free(mesh, V0, V1)
+    vertices, increments = crossing_followers(mesh, V0, V1, n_body=4)
+    ride = dict(zip(vertices.tolist(), increments, strict=True))
+    assert sorted(ride) == [0, 1, 2, 3]
+    np.testing.assert_allclose(ride[2], [0.0, 0.0, 0.28], atol=1e-15)
+    np.testing.assert_allclose(ride[3], [0.0, 0.0, 0.28], atol=1e-15)
+    np.testing.assert_allclose(ride[1], [0.0, 0.0, 0.3], atol=1e-15)
+    moved = V0 + np.array([ride[v] for v in range(4)])
+    assert ipctk.is_step_collision_free(mesh, V0, moved)
+    mean = V1.copy()
+    mean[2:] += [0.0, 0.0, 0.2]
+    assert not ipctk.is_step_collision_free(mesh, V0, mean)
