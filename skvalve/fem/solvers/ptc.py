@@ -107,10 +107,11 @@ class _Rejected(Exception):
 
 
 def switched_evolution_factor(previous: float, current: float, growth: float, held: float = 1.0) -> float:
-    r"""Switched evolution relaxation's pseudo-step factor (Mulder & Van Leer 1985, *J. Comput. Phys.* 59:232):
-    :math:`\lVert R_{k-1}\rVert/\lVert R_k\rVert`, at least ``held`` while the residual does not grow and at least
-    1/2 when it does, at most ``growth``: the pseudo-step grows as the residual falls, so :math:`\Delta\tau\,\lVert
-    R\rVert` stays about constant and the damping fades into Newton's steps near the equilibrium."""
+    r"""Switched evolution relaxation's pseudo-step factor :math:`\lVert R_{k-1}\rVert/\lVert R_k\rVert`, at
+    least ``held`` while the residual does not grow and at least 1/2 when it does, at most ``growth``.
+
+    The pseudo-step grows as the residual falls, so :math:`\Delta\tau\,\lVert R\rVert` stays about constant and
+    the damping fades into Newton's steps near the equilibrium (Mulder & Van Leer 1985, J Comput Phys 59:232)."""
     return min(growth, max(previous / max(current, 1e-300), held if current <= previous else 0.5))
 
 
