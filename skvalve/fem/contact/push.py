@@ -155,7 +155,7 @@ def crossing_followers(mesh: ipctk.CollisionMesh, V0: np.ndarray, V1: np.ndarray
             for vertex, increment in zip(follower.tolist(), riding, strict=True):
                 if vertex < n_body:
                     follows.setdefault(vertex, increment)
-            for vertex in sides[lead].tolist():
+            for vertex in leader.tolist():
                 if vertex < n_body:
                     leads.setdefault(vertex, motion[vertex])
     if not follows:
