@@ -11,7 +11,7 @@ import pytest
 
 from skvalve.fem import Solid
 from skvalve.fem.contact import IPCContact, Obstacle
-from skvalve.fem.contact.push import closest_points_on_triangles, crossing_followers, pushed_vertices
+from skvalve.fem.contact.push import closest_points_on_triangles, crossing_followers, pushed_vertices, rigid_motion
 from skvalve.fem.meshes import box
 from skvalve.fem.solvers import linsolve
 from skvalve.fem.solvers.extension import MotionExtension
@@ -164,3 +164,49 @@ def test_a_crossed_edge_rides_with_the_motion_of_its_closest_point_on_a_turning_
     mean = V1.copy()
     mean[2:] += [0.0, 0.0, 0.2]
     assert not ipctk.is_step_collision_free(mesh, V0, mean)
+
+
+def test_rigid_motion_is_recovered_from_a_turned_plate_and_refused_for_a_deforming_one():
+    """Kabsch's fit on a flat plate (coplanar points) turned by 0.7 rad about a tilted axis and shifted: the rotation
+    and shift come back to round-off, and a point off the plate moved by (R - I) p + c lands where the rigid map puts
+    it; a plate stretched by 1e-6 is not rigid (None)."""
+    rng = np.random.default_rng(3)
+    plate = np.column_stack([rng.uniform(-1, 1, (12, 2)), np.zeros(12)])
+    axis = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    R = np.eye(3) + np.sin(0.7) * K + (1 - np.cos(0.7)) * K @ K
+    c = np.array([0.1, 0.2, -0.3])
+    fit = rigid_motion(plate, plate @ R.T + c)
+    assert fit is not None
+    np.testing.assert_allclose(fit[0], R, atol=1e-13)
+    np.testing.assert_allclose(fit[1], c, atol=1e-13)
+    p = np.array([[0.2, 0.1, 0.05]])
+    np.testing.assert_allclose(p + p @ (fit[0] - np.eye(3)).T + fit[1], p @ R.T + c, atol=1e-13)
+    stretched = plate @ R.T + c
+    stretched[:, 0] *= 1.0 + 1e-6
+    assert rigid_motion(plate, stretched) is None
+    assert rigid_motion(plate[:2], plate[:2] + c) is None  # two points fix no rotation
+
+
+def test_what_a_turning_rigid_obstacle_crosses_rides_with_its_rigid_motion():
+    """A square plate (kinematic, rows 2-5) turns 0.1 rad about the x-axis, its far edge rising through a body edge
+    that lies askew 1e-3 above it. The body edge's ends ride with the plate's rigid motion (R - I) p, in closed form,
+    and moved so the step is collision-free."""
+    body = np.array([[0.5, 0.8, 1e-3], [0.9, 1.2, 1e-3]])
+    plate = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]])
+    angle = 0.1
+    R = np.array([[1.0, 0.0, 0.0], [0.0, np.cos(angle), -np.sin(angle)], [0.0, np.sin(angle), np.cos(angle)]])
+    V0 = np.vstack([body, plate])
+    faces = np.array([[2, 3, 4], [2, 4, 5]])
+    edges = np.vstack([[[0, 1]], ipctk.edges(faces)])
+    mesh = ipctk.CollisionMesh(V0, edges, faces)
+    V1 = np.vstack([body, plate @ R.T])
+    assert not ipctk.is_step_collision_free(mesh, V0, V1)
+    vertices, increments = crossing_followers(mesh, V0, V1, n_body=2, obstacles=[slice(2, 6)])
+    assert sorted(vertices.tolist()) == [0, 1]
+    ride = dict(zip(vertices.tolist(), increments, strict=True))
+    for v in (0, 1):
+        np.testing.assert_allclose(ride[v], body[v] @ R.T - body[v], atol=1e-14)
+    moved = V1.copy()
+    moved[:2] += np.array([ride[0], ride[1]])
+    assert ipctk.is_step_collision_free(mesh, V0, moved)

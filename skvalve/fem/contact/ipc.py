@@ -384,10 +384,12 @@ class IPCContact(Term):
 
     def crossed(self, u0: np.ndarray, t0: float, u1: np.ndarray, t1: float) -> tuple[np.ndarray, np.ndarray] | None:
         """The body's surface dofs on a side of a primitive pair (point-triangle, edge-edge) whose straight move from
-        ``(u0, t0)`` to ``(u1, t1)`` collides (ipctk's narrow-phase CCD), each with the mean motion of the other
-        side, which crosses it: an obstacle's side always, else the side that moves more (:mod:`.push`)."""
-        local, increments = crossing_followers(self.mesh, self.positions(u0, t0, phase_at=t1), self.positions(u1, t1),
-                                               self.n_body)
+        ``(u0, t0)`` to ``(u1, t1)`` collides (ipctk's narrow-phase CCD), each moving with the other side, which
+        crosses it: an obstacle's side always (by its rigid motion), else the side that moves more
+        (:func:`~.push.crossing_followers`)."""
+        V0 = self.positions(u0, t0, phase_at=t1)
+        rows = [r for r in self._phase.slices if r is not None]
+        local, increments = crossing_followers(self.mesh, V0, self.positions(u1, t1), self.n_body, rows)
         if local.size == 0:
             return None
         return _dofs_of(self.nodes[local]), increments.ravel()

@@ -17,7 +17,9 @@ So the obstacle pushes: each body vertex :math:`p` whose closest obstacle point 
 
 starts the step moved by :math:`\Delta q`. Along the straight move of the CCD the point
 :math:`\sum_i\beta_i y_i(s)` is exactly the moved vertex minus its old offset :math:`p - q`, so a pushed vertex keeps
-its place on the moving facet (its distance to the facet's plane changes by the cosine of the facet's turn). The
+its place on the moving facet (its distance to the facet's plane changes by the cosine of the facet's turn). Where
+the obstacle moves rigidly, :math:`y(t_1) = R\,y(t_0) + c` (:func:`rigid_motion`), the vertex moves by that motion
+instead, :math:`(R - I)\,p + c`, and keeps its distance exactly. The
 rest of the body follows by the harmonic extension
 (:class:`~skvalve.fem.solvers.extension.MotionExtension`, pushed dofs as prescribed ones), and the step's
 minimisation then finds where the pushed body comes to rest. The push is a start, not a constraint: it changes no
@@ -26,11 +28,13 @@ minimiser.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import ipctk
 import numpy as np
 from scipy.spatial import cKDTree
 
-__all__ = ["closest_points_on_triangles", "pushed_vertices", "crossing_followers"]
+__all__ = ["closest_points_on_triangles", "rigid_motion", "pushed_vertices", "crossing_followers"]
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -77,11 +81,34 @@ def closest_points_on_triangles(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: 
     return q, beta
 
 
+def rigid_motion(start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    r"""``(R, c)`` with ``end`` :math:`= R\,` ``start`` :math:`+ c` (rows; Kabsch's fit of a rotation and a
+    translation), or ``None`` where ``start`` (m, 3) spans no plane or the fit misses ``end`` by more than
+    :math:`10^{-9}` of the points' extent (an obstacle that deforms). Every point riding with a rigid obstacle moves by
+    :math:`(R - I)\,p + c`, the same affine map as the obstacle along the straight move :math:`p + s\,((R-I)p + c)`,
+    so a pair riding together keeps its gap's sign for all :math:`s` (the map :math:`I + s(R - I)` is invertible for
+    turns below 180°)."""
+    start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+    if start.shape[0] < 3:
+        return None
+    c0, c1 = start.mean(axis=0), end.mean(axis=0)
+    U, sigma, Vt = np.linalg.svd((start - c0).T @ (end - c1))
+    extent = float(np.max(np.linalg.norm(start - c0, axis=1)))
+    if not sigma[1] > 1e-12 * max(sigma[0], 1e-300):
+        return None
+    d = np.sign(np.linalg.det(Vt.T @ U.T)) or 1.0
+    R = Vt.T @ np.diag([1.0, 1.0, d]) @ U.T
+    c = c1 - R @ c0
+    if np.max(np.linalg.norm(start @ R.T + c - end, axis=1)) > 1e-9 * max(extent, 1e-300):
+        return None
+    return R, c
+
+
 def pushed_vertices(points: np.ndarray, start: np.ndarray, end: np.ndarray, triangles: np.ndarray, dhat: float
                     ) -> tuple[np.ndarray, np.ndarray]:
     """``(index, increment)``: the rows of ``points`` (n, 3) that an obstacle moving from vertex positions ``start``
-    to ``end`` (m, 3; facets ``triangles``) pushes (module docstring), and the motion (k, 3) of their closest
-    obstacle points."""
+    to ``end`` (m, 3; facets ``triangles``) pushes (module docstring), and their increments (k, 3): the obstacle's
+    rigid motion where it moves rigidly, else the motion of their closest obstacle points."""
     points = np.asarray(points, dtype=float)
     start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
     triangles = np.asarray(triangles, dtype=np.int64)
@@ -105,6 +132,9 @@ def pushed_vertices(points: np.ndarray, start: np.ndarray, end: np.ndarray, tria
     rows, distance, q = rows[first], distance[first], q[first]
     dq = np.einsum("ki,kij->kj", beta[first], motion[triangles[facets[first]]])
     pushed = (distance < dhat + np.linalg.norm(dq, axis=1)) & (_dot(dq, points[rows] - q) > 0.0)
+    rigid = rigid_motion(start, end)
+    if rigid is not None:
+        return rows[pushed], points[rows[pushed]] @ (rigid[0] - np.eye(3)).T + rigid[1]
     return rows[pushed], dq[pushed]
 
 
@@ -122,8 +152,8 @@ def _motion_at(points: np.ndarray, corners: np.ndarray, motion: np.ndarray) -> n
     return beta @ motion
 
 
-def crossing_followers(mesh: ipctk.CollisionMesh, V0: np.ndarray, V1: np.ndarray, n_body: int
-                       ) -> tuple[np.ndarray, np.ndarray]:
+def crossing_followers(mesh: ipctk.CollisionMesh, V0: np.ndarray, V1: np.ndarray, n_body: int,
+                       obstacles: Sequence[slice] = ()) -> tuple[np.ndarray, np.ndarray]:
     """``(vertices, increments)``: the body vertices (rows below ``n_body``) on a side of a primitive pair
     (point-triangle, edge-edge) whose straight move from ``V0`` to ``V1`` collides (ipctk's narrow-phase CCD), each
     with the motion (k, 3) of its closest point on the other side, the one that crosses it (an obstacle's side always,
@@ -132,14 +162,28 @@ def crossing_followers(mesh: ipctk.CollisionMesh, V0: np.ndarray, V1: np.ndarray
     motion into the rest of the body (the extension's ring around them) does not move what they follow. A vertex that
     follows in one pair and leads in another follows.
 
+    Where the crossing side belongs to a rigid obstacle (its rows one of the slices ``obstacles``), its followers move
+    by the obstacle's own rigid motion (:func:`rigid_motion`), which keeps them exactly where they are relative to it.
+
     Why the closest point's motion, not the side's mean: on the 1.0 clip input two leaflet edges 8.5e-4 mm apart
     crossed again in every round (rounds 3 to 6, the same 12 dofs), the follower moving with the mean of an edge
-    whose ends moved 2.5e-3 mm apart."""
+    whose ends moved 2.5e-3 mm apart. Why the obstacle's rigid motion: a leaflet edge 1.1e-4 mm from a turning arm's
+    edge, moved with its closest points on that edge, still crossed it (the two edges lie askew, so both of the
+    follower's ends took the motion of nearly one point of the turning edge)."""
     candidates = ipctk.Candidates()
     candidates.build(mesh, V0, V1)
     motion = V1 - V0
     follows: dict[int, np.ndarray] = {}
     leads: dict[int, np.ndarray] = {}
+    fits: dict[int, tuple[np.ndarray, np.ndarray] | None] = {}
+
+    def rigid_of(vertex: int) -> tuple[np.ndarray, np.ndarray] | None:
+        for k, rows in enumerate(obstacles):
+            if rows.start <= vertex < rows.stop:
+                if k not in fits:
+                    fits[k] = rigid_motion(V0[rows], V1[rows])
+                return fits[k]
+        return None
     for stencils, split in ((candidates.fv_candidates, 1), (candidates.ee_candidates, 2)):
         for stencil in stencils:
             ids = np.asarray(stencil.vertex_ids(mesh.edges, mesh.faces))
@@ -151,7 +195,11 @@ def crossing_followers(mesh: ipctk.CollisionMesh, V0: np.ndarray, V1: np.ndarray
             lead = 0 if kinematic[0] or (not kinematic[1]
                                          and np.linalg.norm(moves[0]) >= np.linalg.norm(moves[1])) else 1
             leader, follower = sides[lead], sides[1 - lead]
-            riding = _motion_at(V0[follower], V0[leader], motion[leader])
+            rigid = rigid_of(int(leader.max())) if kinematic[lead] else None
+            if rigid is not None:
+                riding = V0[follower] @ (rigid[0] - np.eye(3)).T + rigid[1]
+            else:
+                riding = _motion_at(V0[follower], V0[leader], motion[leader])
             for vertex, increment in zip(follower.tolist(), riding, strict=True):
                 if vertex < n_body:
                     follows.setdefault(vertex, increment)
