@@ -29,7 +29,7 @@ import skfem as fem
 
 from .errors import TangledMeshError
 
-__all__ = ["Space", "element_family"]
+__all__ = ["Space", "element_family", "node_dofs"]
 
 _FAMILIES = {
     "hex": (fem.ElementHex1, fem.ElementHex2, (3, 5)),
@@ -37,6 +37,11 @@ _FAMILIES = {
     "quad": (fem.ElementQuad1, fem.ElementQuad2, (3, 5)),
     "tri": (fem.ElementTriP1, fem.ElementTriP2, (1, 2)),
 }
+
+
+def node_dofs(nodes: np.ndarray, dim: int = 3) -> np.ndarray:
+    """The displacement dofs of ``nodes`` (node-major, ``dim`` per node), in the nodes' order."""
+    return (dim * np.asarray(nodes, dtype=np.int64)[:, None] + np.arange(dim)).ravel()
 
 
 def element_family(mesh: fem.Mesh) -> str:

@@ -64,7 +64,7 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from ..errors import StateRefused
-from ..space import Space
+from ..space import Space, node_dofs
 from ..terms import Contribution, Term
 from .activation import CollisionPhase, CollisionPhases
 from .obstacles import Obstacle, Plane
@@ -124,11 +124,6 @@ def stiffness_for_pressure(pressure: float, dhat: float, at: float = 0.5) -> flo
     if not (np.isfinite(pressure) and pressure > 0.0 and np.isfinite(dhat) and dhat > 0.0):
         raise ValueError(f"stiffness_for_pressure: pressure and dhat must be positive; got {pressure!r}, {dhat!r}")
     return float(pressure / barrier_pressure(at * dhat, dhat, 1.0))
-
-
-def _dofs_of(nodes: np.ndarray) -> np.ndarray:
-    """The displacement dofs (node-major, three per node) of scalar nodes ``nodes``."""
-    return (3 * np.asarray(nodes, dtype=np.int64)[:, None] + np.arange(3)).ravel()
 
 
 class IPCContact(Term):
@@ -202,7 +197,7 @@ class IPCContact(Term):
         self.collisions = ipctk.NormalCollisions()
         self.collisions.use_area_weighting = True
         self._built_for: tuple[tuple[bool, ...], np.ndarray] | None = None
-        rows = _dofs_of(self.nodes)
+        rows = node_dofs(self.nodes)
         select = sp.csr_matrix((np.ones(rows.size), (rows, np.arange(rows.size))),
                                shape=(space.n_dofs, 3 * self.rest.shape[0]))
         self._phases = CollisionPhases(self.rest, self.n_body, local[surface.triangles], self.obstacles,
@@ -380,7 +375,7 @@ class IPCContact(Term):
         if not nodes or not sum(n.size for n in nodes):
             return None
         nodes, first = np.unique(np.concatenate(nodes), return_index=True)
-        return _dofs_of(nodes), np.concatenate(increments)[first].ravel()
+        return node_dofs(nodes), np.concatenate(increments)[first].ravel()
 
     def crossed(self, u0: np.ndarray, t0: float, u1: np.ndarray, t1: float) -> tuple[np.ndarray, np.ndarray] | None:
         """The body's surface dofs on a side of a primitive pair (point-triangle, edge-edge) whose straight move from
@@ -392,7 +387,7 @@ class IPCContact(Term):
         local, increments = crossing_followers(self.mesh, V0, self.positions(u1, t1), self.n_body, rows)
         if local.size == 0:
             return None
-        return _dofs_of(self.nodes[local]), increments.ravel()
+        return node_dofs(self.nodes[local]), increments.ravel()
 
     def intersects(self, u: np.ndarray, t: float) -> bool:
         """True when the collision mesh intersects itself at ``u``, ``t`` (ipctk ``has_intersections``) or a surface

@@ -104,6 +104,12 @@ def rigid_motion(start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.nda
     return R, c
 
 
+def _rigid_increments(rigid: tuple[np.ndarray, np.ndarray], points: np.ndarray) -> np.ndarray:
+    r"""The increments (k, 3) of ``points`` riding with the rigid motion ``(R, c)``: :math:`(R - I)\,p + c`."""
+    R, c = rigid
+    return points @ (R - np.eye(3)).T + c
+
+
 def pushed_vertices(points: np.ndarray, start: np.ndarray, end: np.ndarray, triangles: np.ndarray, dhat: float
                     ) -> tuple[np.ndarray, np.ndarray]:
     """``(index, increment)``: the rows of ``points`` (n, 3) that an obstacle moving from vertex positions ``start``
@@ -132,10 +138,8 @@ def pushed_vertices(points: np.ndarray, start: np.ndarray, end: np.ndarray, tria
     rows, distance, q = rows[first], distance[first], q[first]
     dq = np.einsum("ki,kij->kj", beta[first], motion[triangles[facets[first]]])
     pushed = (distance < dhat + np.linalg.norm(dq, axis=1)) & (_dot(dq, points[rows] - q) > 0.0)
-    rigid = rigid_motion(start, end)
-    if rigid is not None:
-        return rows[pushed], points[rows[pushed]] @ (rigid[0] - np.eye(3)).T + rigid[1]
-    return rows[pushed], dq[pushed]
+    rigid = rigid_motion(start, end) if np.any(pushed) else None
+    return rows[pushed], (dq[pushed] if rigid is None else _rigid_increments(rigid, points[rows[pushed]]))
 
 
 def _motion_at(points: np.ndarray, corners: np.ndarray, motion: np.ndarray) -> np.ndarray:
@@ -196,10 +200,8 @@ def crossing_followers(mesh: ipctk.CollisionMesh, V0: np.ndarray, V1: np.ndarray
                                          and np.linalg.norm(moves[0]) >= np.linalg.norm(moves[1])) else 1
             leader, follower = sides[lead], sides[1 - lead]
             rigid = rigid_of(int(leader.max())) if kinematic[lead] else None
-            if rigid is not None:
-                riding = V0[follower] @ (rigid[0] - np.eye(3)).T + rigid[1]
-            else:
-                riding = _motion_at(V0[follower], V0[leader], motion[leader])
+            riding = (_motion_at(V0[follower], V0[leader], motion[leader]) if rigid is None
+                      else _rigid_increments(rigid, V0[follower]))
             for vertex, increment in zip(follower.tolist(), riding, strict=True):
                 if vertex < n_body:
                     follows.setdefault(vertex, increment)

@@ -56,7 +56,7 @@ import scipy.sparse as sp
 import skfem as fem
 
 from ..errors import NonPositiveJacobianError, TangledMeshError
-from ..space import Space
+from ..space import Space, node_dofs
 from ..terms import Contribution, Term
 
 __all__ = ["CornerBarrier", "corner_barrier_phi", "hex_corner_stencils"]
@@ -239,7 +239,7 @@ class CornerBarrier(Term):
         sums, counts = np.zeros((nodes.size, 3)), np.zeros(nodes.size)
         np.add.at(sums, where.ravel(), np.repeat(mean, 8, axis=0))
         np.add.at(counts, where.ravel(), 1.0)
-        return (3 * nodes[:, None] + np.arange(3)).ravel(), (sums / counts[:, None]).ravel()
+        return node_dofs(nodes), (sums / counts[:, None]).ravel()
 
     def _first_roots(self, u0: np.ndarray, u1: np.ndarray) -> np.ndarray:
         """Per corner, the first share in (0, 1] of the straight move at which its Jacobian reaches zero (2 where it
