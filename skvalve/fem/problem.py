@@ -22,6 +22,7 @@ from .errors import SingularSystemError
 from .kernels import csr_positions, csr_structure, scatter_add
 from .loads import Dirichlet
 from .space import Space
+from .sparse_layout import GrowingPattern
 from .terms import Contribution, Term
 
 __all__ = ["Problem", "Tangent", "Pattern"]
@@ -37,6 +38,7 @@ class Pattern:
     indptr: np.ndarray
     indices: np.ndarray
     positions: list[list[np.ndarray]]  # per term, per block: (n, m, m) CSR positions
+    layout: GrowingPattern  # the tangent's pattern: this one, the diagonal and the terms' extra entries seen so far
 
 
 @dataclass
@@ -150,7 +152,8 @@ class Problem:
                     continue
                 blocks.append(csr_positions(reduced[c], indptr, indices))
             per_term.append(blocks)
-        return Pattern(fixed, free, reduced, indptr.astype(np.int32), indices.astype(np.int32), per_term)
+        return Pattern(fixed, free, reduced, indptr.astype(np.int32), indices.astype(np.int32), per_term,
+                       GrowingPattern(indptr, indices, free.size))
 
     def check_supports(self) -> None:
         """Raise :class:`SingularSystemError` if the constraints leave a rigid-body motion free.
@@ -229,8 +232,11 @@ class Problem:
         self.internal_forces, self.external_forces = internal, external
         return internal - external, Tangent(contributions)
 
-    def tangent_matrix(self, tangent: Tangent, blocks=None, matrix=None, projected: bool = False) -> sp.csr_matrix:
-        """Free-dof tangent K_ff from the contributions of :meth:`assemble`.
+    def tangent_matrix(self, tangent: Tangent, blocks=None, matrix=None, projected: bool = False,
+                       diagonal: np.ndarray | None = None) -> sp.csr_matrix:
+        """Free-dof tangent K_ff (plus ``diagonal``) from the contributions of :meth:`assemble`, on the problem's
+        growing pattern (:class:`~skvalve.fem.sparse_layout.GrowingPattern`: the same pattern while the terms' extra
+        entries stay within it, so a direct solver keeps its analysis).
 
         ``blocks(term, matrices) -> matrices`` and ``matrix(term, sparse) -> sparse``, when given, replace each term's
         element blocks and extra matrix before they are added (e.g. their symmetric parts, or blocks projected onto
@@ -240,7 +246,7 @@ class Problem:
         """
         pat = self.pattern
         data = np.zeros(pat.indices.size)
-        extra = None
+        extra = []
         for term, positions, contribution in zip(self.terms, pat.positions, tangent.contributions, strict=True):
             for pos, block in zip(positions, contribution.blocks, strict=True):
                 if block.matrices is None:
@@ -256,11 +262,19 @@ class Problem:
                 if projected and contribution.projected_matrix is not None:
                     own = contribution.projected_matrix
                 whole = own if matrix is None else matrix(term, own)
-                part = sp.csr_matrix(whole)[pat.free][:, pat.free]
-                extra = part if extra is None else extra + part
-        nfree = pat.free.size
-        K = sp.csr_matrix((data, pat.indices, pat.indptr), shape=(nfree, nfree))
-        return K if extra is None else (K + extra).tocsr()
+                extra.append(sp.csr_matrix(whole)[pat.free][:, pat.free].tocoo())
+        if not extra:
+            return pat.layout.matrix(data, diagonal=diagonal)
+        rows, cols, values = (np.concatenate([getattr(part, key) for part in extra]) for key in ("row", "col", "data"))
+        return pat.layout.matrix(data, rows, cols, values, diagonal)
+
+    def add_diagonal(self, matrix: sp.spmatrix, diagonal: np.ndarray) -> sp.csr_matrix:
+        """``matrix + diag(diagonal)`` (free dofs) on the tangent's pattern where ``matrix`` is on it."""
+        return self.pattern.layout.add_diagonal(matrix, diagonal)
+
+    def symmetric_part(self, matrix: sp.spmatrix, diagonal: np.ndarray | None = None) -> sp.csr_matrix:
+        """``(K + K^T) / 2`` (plus ``diagonal``) on the tangent's pattern where ``K`` is on it."""
+        return self.pattern.layout.symmetric_part(matrix, diagonal)
 
     def apply(self, tangent: Tangent, vector: np.ndarray) -> np.ndarray:
         """Full tangent (all dofs) times ``vector``."""

@@ -288,10 +288,10 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
     newton_allowed = True  # False once a full-tangent step raised |grad E| (a non-convex region: stay projected)
     shifted = opts.direction == "shifted" and solver == "pardiso"
     shift, projected = 0.0, False
-    mass = sp.diags(inertia[free], format="csr")
+    mass = inertia[free]
 
     def projected_with_mass(tangent: Tangent) -> sp.csr_matrix:
-        return projected_tangent(problem, tangent) + mass
+        return projected_tangent(problem, tangent, diagonal=mass)
 
     def scale(residual: np.ndarray) -> float:
         """The relative residual's force scale: ``opts.reference``, else the reactions' and loads' norm."""
@@ -310,20 +310,20 @@ def minimise_step(problem: Problem, u_old: np.ndarray, t_old: float, t_new: floa
         clock = time.perf_counter()
         if shifted:
             K = problem.tangent_matrix(tangent)
-            H = 0.5 * (K + K.T) + mass  # K itself where every term has a potential
+            H = problem.symmetric_part(K, diagonal=mass)  # K itself where every term has a potential
             direction, shift, projected = shifted_newton(H, -gradient[free], shift, solver,
                                                          fallback=partial(projected_with_mass, tangent))
             newton = shift == 0.0 and not projected and energy_merit
             if shift < NEWTON_AGAIN_BELOW and not energy_merit and norm <= opts.newton_below * reference:
                 # near the solution: the full (non-symmetric) tangent for Newton's rate, where it points downhill
-                full = linsolve.solve(K + mass, -gradient[free], solver)
+                full = linsolve.solve(problem.add_diagonal(K, mass), -gradient[free], solver)
                 if float(full @ gradient[free]) < 0.0:
                     direction, newton = full, True
         else:
             # without a potential: Newton's direction (the projected one need not lower |grad E|); with one:
             # projected Newton until close
             newton = (newton_allowed and norm <= opts.newton_below * reference) or not energy_merit
-            K = problem.tangent_matrix(tangent) + mass if newton else projected_with_mass(tangent)
+            K = problem.tangent_matrix(tangent, diagonal=mass) if newton else projected_with_mass(tangent)
             direction = linsolve.solve(K, -gradient[free], solver, symmetric=problem.symmetric or not newton)
             if newton and not float(direction @ gradient[free]) < 0.0:  # not descent: projected
                 newton = False

@@ -43,7 +43,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 from tqdm.auto import tqdm
 
 from ..errors import ConvergenceError, NonPositiveJacobianError, OutputError, SingularSystemError, SolverError
@@ -187,7 +186,7 @@ def _newton_step(problem: Problem, u_old, t_old: float, t_new: float, step: int,
         start = time.perf_counter()
         K = problem.tangent_matrix(tangent)
         if shift >= _SHIFT_FLOOR:
-            K = K + sp.diags(shift * np.abs(K.diagonal()), format="csr")
+            K = problem.add_diagonal(K, shift * np.abs(K.diagonal()))
         opts.timings["assembly"] += time.perf_counter() - start
         try:
             du_free = _linear_solve(problem, K, -rhs[free], opts)

@@ -37,7 +37,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 from tqdm.auto import tqdm
 
 from ..errors import ConvergenceError, NonPositiveJacobianError
@@ -277,7 +276,7 @@ def _step(problem: Problem, u, t_old: float, t_new: float, dtau: float, tangent,
         raise ValueError(f"stiffness_damping must be finite and >= 0; got {beta!r} at load factor {t_new}")
     if beta > 0.0:
         diagonal = diagonal + beta * np.abs(K.diagonal())
-    K = K + sp.diags(boost[free] * diagonal / dtau, format="csr")
+    K = problem.add_diagonal(K, boost[free] * diagonal / dtau)
     timings["assembly"] += time.perf_counter() - clock
     clock = time.perf_counter()
     try:

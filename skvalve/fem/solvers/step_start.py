@@ -17,7 +17,6 @@ import math
 from collections.abc import Callable
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..errors import NonPositiveJacobianError
 from ..problem import Problem
@@ -41,7 +40,7 @@ def consistent_predictor(problem: Problem, u_old: np.ndarray, u: np.ndarray, t_n
     residual, tangent = problem.assemble(u_old, t_new, tangent=True, step=step)
     rhs = residual + problem.apply(tangent, u - u_old) + inertia * (u - predictor)  # linearised at u_old
     K = problem.tangent_matrix(tangent) if not energy_merit else projected_tangent(problem, tangent)
-    K = K + sp.diags(inertia[free], format="csr")
+    K = problem.add_diagonal(K, inertia[free])
     try:
         direction = linsolve.solve(K, -rhs[free], solver, symmetric=problem.symmetric or energy_merit)
     except np.linalg.LinAlgError:

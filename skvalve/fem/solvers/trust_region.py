@@ -234,7 +234,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
                     retry_below = math.inf
                     record(step, work, math.nan, 0.0, largest, True, "newton try")
                     continue
-            symmetric_K = (0.5 * (K + K.T)).tocsr()
+            symmetric_K = problem.symmetric_part(K)
             H = step_matrix(problem, tangent, opts.project, opts.project_terms, opts.shift_terms) \
                 if opts.project or opts.project_terms or opts.shift_terms else symmetric_K
             scale = np.abs(H.diagonal())
@@ -243,7 +243,7 @@ def trust_region(problem: Problem, t: float, u0: np.ndarray, options: TrustRegio
             D = sp.diags(diagonal if opts.shift_scaling == "diagonal" else np.full(scale.size, typical), format="csr")
             model = H  # the model's Hessian: the step matrix without the shifts (the true tangent for Newton)
             if np.any(local[free] > 0.0):
-                H = (H + sp.diags(local[free] * diagonal, format="csr")).tocsr()
+                H = problem.add_diagonal(H, local[free] * diagonal)
             result.timings["assembly"] += time.perf_counter() - clock
             clock = time.perf_counter()
             direction, shift, newton = shifted_direction(solvers, symmetric_K, K, H, D, -residual[free], shift,

@@ -35,9 +35,10 @@ def project_psd(matrices: np.ndarray) -> np.ndarray:
     return (vectors * np.maximum(values, 0.0)[..., None, :]) @ np.swapaxes(vectors, -1, -2)
 
 
-def projected_tangent(problem: Problem, tangent: Tangent) -> sp.csr_matrix:
+def projected_tangent(problem: Problem, tangent: Tangent, diagonal: np.ndarray | None = None) -> sp.csr_matrix:
     """The free-dof tangent with every symmetric term's element blocks projected onto their PSD parts, a term's own
-    projected sparse matrix where it gives one (contact stencils) and the symmetric part of everything else."""
+    projected sparse matrix where it gives one (contact stencils) and the symmetric part of everything else; plus
+    ``diagonal`` (free dofs)."""
 
     def blocks(term, matrices):
         if getattr(term, "symmetric", True):
@@ -47,7 +48,7 @@ def projected_tangent(problem: Problem, tangent: Tangent) -> sp.csr_matrix:
     def matrix(term, sparse):
         return 0.5 * (sparse + sparse.T)
 
-    return problem.tangent_matrix(tangent, blocks=blocks, matrix=matrix, projected=True).tocsr()
+    return problem.tangent_matrix(tangent, blocks=blocks, matrix=matrix, projected=True, diagonal=diagonal)
 
 
 def shift_psd(matrices: np.ndarray) -> np.ndarray:
