@@ -5,9 +5,9 @@ Closes ``--input`` (default the 1.0 diseased valve, :func:`skvalve.io.abaqus.tri
 input's step time, then the held load; an earlier ``--end`` runs the load path only). Prints the machine's load
 before and after (the machine may be shared), wall time, path and held steps, iterations, cut-backs, final static
 residual, intersection, smallest corner Jacobian, contact pairs and where the time went, measured by wrapping the
-calls with timers (no profiler): each term's assembly and energy by term type, the tangent's sparse sum, CCD
-(``IPCContact.step_fraction``), the intersection checks and the collision counts of the step records, and the
-pattern set-up, factorisation (of which PARDISO's reordering, once per new pattern) and solve of
+calls with timers (no profiler): each term's assembly and energy by term type, the tangent's assembly (of which its
+pattern's growths), CCD (``IPCContact.step_fraction``), the intersection checks and the collision counts of the step
+records, and the pattern set-up, factorisation (of which PARDISO's reordering, once per new pattern) and solve of
 :class:`skvalve.fem.solvers.linsolve.LinearSolver`. Target for the 1.0 diseased
 valve from the open state: <= 1800 s on 2 cores. Needs the input (``$SKVALVE_TRIVALVE``; Mathur et al. 2022, CC BY-NC-SA
 4.0); exits 2 without it.
@@ -25,6 +25,7 @@ from collections import defaultdict
 from pathlib import Path
 
 from skvalve.fem.solvers.linsolve import LinearSolver
+from skvalve.fem.sparse_layout import GrowingPattern
 from skvalve.io.abaqus import trivalve_input
 from skvalve.valve.options import CloseOptions, HoldOptions
 from skvalve.valve.run import STATE_FILE, CloseReport, ClosureFailed, close_valve
@@ -89,7 +90,9 @@ def instrument(setup, timers: Timers) -> None:
         timers.wrap(term, "assemble", f"assembly {kind}")
         if getattr(term, "energy", None) is not None:
             timers.wrap(term, "energy", f"energy {kind}")
-    timers.wrap(setup.problem, "tangent_matrix", "tangent sparse sum (Problem.tangent_matrix)")
+    tangent = "tangent assembly (Problem.tangent_matrix)"
+    timers.wrap(setup.problem, "tangent_matrix", tangent)
+    timers.wrap(GrowingPattern, "_insert", "pattern growth (GrowingPattern)", within=tangent)
     timers.wrap(setup.contact, "step_fraction", "CCD (IPCContact.step_fraction)")
     timers.wrap(setup.contact, "intersects", "intersection checks (IPCContact.intersects)")
     timers.wrap(setup.contact, "active_pairs", "collision counts (IPCContact.active_pairs)")
