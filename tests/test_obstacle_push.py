@@ -120,8 +120,8 @@ def test_a_spike_crossing_a_face_that_no_node_faces_carries_the_face_to_the_equi
 def test_a_crossed_triangle_rides_with_the_vertex_that_crosses_it():
     """A body triangle at z = 0 and an obstacle spike whose tip, 0.01 below the triangle's inside, rises by 0.1: the
     tip's move crosses the triangle (no body vertex lies in front of an obstacle face, so nothing is pushed), the
-    three body vertices follow the tip's motion, and moved so the step is collision-free. Body motion slower than a
-    body triangle that sweeps into another body vertex: the slower side follows the faster one."""
+    three body vertices follow the tip's motion, and moved so the step is collision-free. A point above a body
+    triangle that sweeps through it (both body): the four vertices form one cluster, translated by their mean motion."""
     body = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
     spike = np.array([[0.3, 0.3, -0.01], [0.0, 0.3, -1.0], [0.6, 0.3, -1.0]])
     V0 = np.vstack([body, spike])
@@ -135,35 +135,41 @@ def test_a_crossed_triangle_rides_with_the_vertex_that_crosses_it():
     V1[:3] += increments[np.argsort(vertices)]
     assert ipctk.is_step_collision_free(mesh, V0, V1)
     assert crossing_followers(mesh, V0, V1, n_body=3)[0].size == 0
-    # two body pieces: a point above the triangle that the triangle (moving 0.1 up) sweeps through follows it
+    # two body pieces: a point above the triangle that the triangle (moving 0.1 up) sweeps through
     V0 = np.vstack([body, [[0.2, 0.2, 0.05]]])
     mesh = ipctk.CollisionMesh(V0, ipctk.edges(faces[:1]), faces[:1])
     V1 = V0 + np.r_[np.tile([0.0, 0.0, 0.1], (3, 1)), np.zeros((1, 3))]
     vertices, increments = crossing_followers(mesh, V0, V1, n_body=4)
-    assert vertices.tolist() == [0, 1, 2, 3]  # the triangle keeps its motion, the point rides with it
-    np.testing.assert_allclose(increments, [[0.0, 0.0, 0.1]] * 4, atol=1e-15)
+    assert sorted(vertices.tolist()) == [0, 1, 2, 3]
+    np.testing.assert_allclose(increments, [[0.0, 0.0, 0.075]] * 4, atol=1e-15)  # (3 x 0.1 + 0) / 4
 
 
-def test_a_crossed_edge_rides_with_the_motion_of_its_closest_point_on_a_turning_edge():
-    """A body edge along x lifts and turns (its ends rise 0.1 and 0.3) under a crossing edge 0.01 above it at
-    x = 0.9. The crossed edge rides with the motion of its closest points on the turning edge (0.28 at x = 0.9), and
-    moved so the step is collision-free; with the turning edge's mean motion (0.2) it would still be crossed."""
-    V0 = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.9, -0.5, 0.01], [0.9, 0.5, 0.01]])
-    edges = np.array([[0, 1], [2, 3]])
+def test_crossing_body_pairs_that_share_vertices_translate_as_one_cluster():
+    """A body edge along x lifts and turns (its ends rise 0.1 and 0.3) under a crossing body edge 0.01 above it at
+    x = 0.9, and a third edge hangs from the crossing edge's end 3, 0.01 above a fourth that rises 0.2 through it. The
+    two crossing pairs share vertex 3, so their seven vertices are one cluster, translated by their mean motion
+    (0.7 / 7 = 0.1): every gap among them stays as it was, and the move is collision-free. The vertices of no crossing
+    pair are not returned."""
+    V0 = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.9, -0.5, 0.01], [0.9, 0.5, 0.01], [0.9, 1.5, 0.01],
+                   [1.4, 1.0, 0.0], [0.4, 1.0, 0.0], [5.0, 5.0, 5.0], [6.0, 5.0, 5.0]])
+    edges = np.array([[0, 1], [2, 3], [3, 4], [5, 6], [7, 8]])
     mesh = ipctk.CollisionMesh(V0, edges, np.zeros((0, 3), dtype=np.int64))
-    V1 = V0 + np.array([[0.0, 0.0, 0.1], [0.0, 0.0, 0.3], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    V1 = V0.copy()
+    V1[[0, 1, 5, 6], 2] += [0.1, 0.3, 0.15, 0.15]
+    V1[[7, 8], 0] += 0.5  # far from everything
     assert not ipctk.is_step_collision_free(mesh, V0, V1)
-    vertices, increments = crossing_followers(mesh, V0, V1, n_body=4)
+    vertices, increments = crossing_followers(mesh, V0, V1, n_body=9)
     ride = dict(zip(vertices.tolist(), increments, strict=True))
-    assert sorted(ride) == [0, 1, 2, 3]
-    np.testing.assert_allclose(ride[2], [0.0, 0.0, 0.28], atol=1e-15)
-    np.testing.assert_allclose(ride[3], [0.0, 0.0, 0.28], atol=1e-15)
-    np.testing.assert_allclose(ride[1], [0.0, 0.0, 0.3], atol=1e-15)
-    moved = V0 + np.array([ride[v] for v in range(4)])
+    assert sorted(ride) == [0, 1, 2, 3, 4, 5, 6]
+    for vertex in ride:
+        np.testing.assert_allclose(ride[vertex], [0.0, 0.0, 0.1], atol=1e-15)
+    moved = V0.copy()
+    moved[vertices] += increments
     assert ipctk.is_step_collision_free(mesh, V0, moved)
-    mean = V1.copy()
-    mean[2:] += [0.0, 0.0, 0.2]
-    assert not ipctk.is_step_collision_free(mesh, V0, mean)
+    pairs = [[0, 1, 2, 3], [3, 4, 5, 6]]
+    before = [ipctk.edge_edge_distance(*V0[pair]) for pair in pairs]
+    after = [ipctk.edge_edge_distance(*moved[pair]) for pair in pairs]
+    np.testing.assert_allclose(after, before, rtol=1e-12)
 
 
 def test_rigid_motion_is_recovered_from_a_turned_plate_and_refused_for_a_deforming_one():
