@@ -34,10 +34,10 @@ def _keys(indptr: np.ndarray, indices: np.ndarray, n: int) -> np.ndarray:
     return rows * n + np.asarray(indices, dtype=np.int64)
 
 
-def _contains(sorted_keys: np.ndarray, keys: np.ndarray) -> np.ndarray:
-    """Which of ``keys`` are among ``sorted_keys``."""
+def _lookup(sorted_keys: np.ndarray, keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(where, found)``: the positions of ``keys`` in ``sorted_keys`` (valid where ``found``)."""
     where = np.minimum(np.searchsorted(sorted_keys, keys), sorted_keys.size - 1)
-    return sorted_keys[where] == keys
+    return where, sorted_keys[where] == keys
 
 
 def _same(a: np.ndarray, b: np.ndarray) -> bool:
@@ -81,7 +81,7 @@ class GrowingPattern:
     def _insert(self, keys: np.ndarray) -> None:
         """Merge the entries ``keys`` (with their transposes once the pattern is symmetric) into the pattern."""
         keys = np.unique(keys)
-        keys = keys[~_contains(self.keys, keys)]
+        keys = keys[~_lookup(self.keys, keys)[1]]
         if keys.size == 0:
             return
         n = self.n
@@ -106,8 +106,8 @@ class GrowingPattern:
         n = self.n
         rows, cols = rows.astype(np.int64), cols.astype(np.int64)
         keys = rows * n + cols
-        where = np.minimum(np.searchsorted(self.keys, keys), self.keys.size - 1)
-        if not np.array_equal(self.keys[where], keys):
+        where, found = _lookup(self.keys, keys)
+        if not found.all():
             held = self.keys.size - self._base[0].size
             current = np.concatenate([keys, cols * n + rows])
             if held > RESET_FACTOR * np.unique(current).size:
@@ -122,14 +122,17 @@ class GrowingPattern:
                values: np.ndarray | None = None, diagonal: np.ndarray | None = None) -> sp.csr_matrix:
         """The matrix of the element pattern's ``element_values`` plus the extra entries ``(rows, cols, values)``
         (duplicates summed) plus ``diagonal``, on this pattern."""
-        if rows is not None and rows.size:
-            positions = self._positions(rows, cols)
+        positions = self._positions(rows, cols) if rows is not None and rows.size else None  # may grow the pattern
         data = np.zeros(self.keys.size)
         data[self._element] = element_values
-        if rows is not None and rows.size:
+        if positions is not None:
             np.add.at(data, positions, values)
         if diagonal is not None:
             data[self._diagonal] += diagonal
+        return self._on_pattern(data)
+
+    def _on_pattern(self, data: np.ndarray) -> sp.csr_matrix:
+        """The CSR matrix of ``data`` on this pattern (its index arrays shared, not copied)."""
         return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
 
     def holds(self, matrix: sp.spmatrix) -> bool:
@@ -143,7 +146,7 @@ class GrowingPattern:
             return sp.csr_matrix(matrix + sp.diags(diagonal))
         data = matrix.data.copy()
         data[self._diagonal] += diagonal
-        return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
+        return self._on_pattern(data)
 
     def symmetric_part(self, matrix: sp.spmatrix, diagonal: np.ndarray | None = None) -> sp.csr_matrix:
         r""":math:`\tfrac12(K + K^T)` (plus ``diagonal``), on this pattern where ``matrix`` is on it (the pattern is
@@ -154,4 +157,4 @@ class GrowingPattern:
         data = 0.5 * (matrix.data + matrix.data[self._transpose])
         if diagonal is not None:
             data[self._diagonal] += diagonal
-        return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
+        return self._on_pattern(data)

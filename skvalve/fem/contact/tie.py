@@ -40,7 +40,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from ..space import Space
+from ..space import Space, node_dofs
 from ..terms import Contribution, Term
 from .obstacles import Obstacle
 
@@ -108,7 +108,7 @@ class ObstacleTie(Term):
     def _set(self, vertex, obstacle, triangle, coords) -> None:
         self.vertex, self.obstacle, self.triangle, self.coords = vertex, obstacle, triangle, coords
         node = self.nodes[vertex]
-        self._dofs = (3 * node[:, None] + np.arange(3)).ravel()
+        self._dofs = node_dofs(node)
         self._weights = np.repeat(self.stiffness * self.areas[vertex], 3)
 
     @property
